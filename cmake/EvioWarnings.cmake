@@ -1,0 +1,12 @@
+# Warning flags live in one INTERFACE target that every evio target links
+# privately; no global flags are set.
+add_library(evio_warnings INTERFACE)
+add_library(evio::warnings ALIAS evio_warnings)
+target_compile_options(evio_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align
+  -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2
+  -Wimplicit-fallthrough)
+if(EVIO_WARNINGS_AS_ERRORS)
+  target_compile_options(evio_warnings INTERFACE -Werror)
+endif()
+target_compile_features(evio_warnings INTERFACE cxx_std_20)

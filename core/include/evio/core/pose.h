@@ -14,7 +14,9 @@ namespace evio {
 class Pose {
  public:
   Pose() = default;
-  Pose(const Quat& q, const Vec3& p) : q_(q.normalized()), p_(p) {}
+  /// The quaternion is normalised unless it is already unit to round-off
+  /// (so a pose read back from a file equals the one written, bit for bit).
+  Pose(const Quat& q, const Vec3& p) : q_(unit(q)), p_(p) {}
   Pose(const Mat3& R, const Vec3& p) : q_(Quat(R).normalized()), p_(p) {}
 
   static Pose identity() { return Pose(); }
@@ -35,6 +37,10 @@ class Pose {
   Vec6 log() const;
 
  private:
+  static Quat unit(const Quat& q) {
+    const double n2 = q.squaredNorm();
+    return (n2 > 1.0 - 4e-16 && n2 < 1.0 + 4e-16) ? q : q.normalized();
+  }
   Quat q_ = Quat::Identity();
   Vec3 p_ = Vec3::Zero();
 };

@@ -1,0 +1,12 @@
+#pragma once
+/// @file commands.h
+/// Each `evio` subcommand lives in its own <name>_command.cpp and registers
+/// itself on the top-level CLI11 app through one of these functions.
+
+#include <CLI/CLI.hpp>
+
+namespace evio::apps {
+
+void addInfoCommand(CLI::App& app);
+
+}  // namespace evio::apps

@@ -1,0 +1,32 @@
+#pragma once
+/// @file progress_line.h
+/// A one-line progress display on stderr for long work: share done, rate
+/// and ETA, refreshed at most every 0.2 s. Silent when stderr is not a
+/// terminal or when quiet, so scripts and logs stay clean.
+
+#include <chrono>
+#include <string>
+
+namespace evio::apps {
+
+class ProgressLine {
+ public:
+  /// `label` starts the line; `unit` names what `update`'s amount counts ("ev", "s sim").
+  ProgressLine(std::string label, std::string unit, bool quiet = false);
+  ~ProgressLine();
+
+  /// `fraction` of the work done (0..1) and the absolute amount processed so far.
+  void update(double fraction, double amount);
+  /// Clears the line (prints a final newline when something was shown).
+  void finish();
+
+ private:
+  std::string label_;
+  std::string unit_;
+  bool enabled_;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+}  // namespace evio::apps

@@ -17,9 +17,10 @@
 
 namespace evio {
 
-/// A point p_C is projectable only if z > kMinCosAngle · |p_C|, i.e. it lies
-/// more than acos(1e-6) ≈ 1e-6 rad in front of the image plane. Points behind
-/// the camera, on the image plane or at the origin are rejected.
+/// A point p_C is projectable only if z > kMinCosAngle · |p_C|, i.e. its ray
+/// makes an angle of more than asin(1e-6) ≈ 1e-6 rad with the image plane, on
+/// the front side. Points behind the camera, on the image plane or at the
+/// origin are rejected.
 inline constexpr double kMinCosAngle = 1e-6;
 
 /// True when p_C is finite and strictly in front of the camera (see kMinCosAngle).

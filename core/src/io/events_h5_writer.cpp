@@ -41,6 +41,7 @@ struct EventH5Writer::Impl {
   bool wide = false;  // /events/t stored as int64
   bool closed = false;
   bool committed = false;
+  bool failed = false;  // a write failed: the file is incomplete
 
   // Declared first so that it is closed last.
   h5::Handle file;
@@ -168,6 +169,7 @@ struct EventH5Writer::Impl {
 
   void append(const EventArray& ev) {
     if (closed) throw Error::inFile(path, 0, "append after close()");
+    if (failed) throw Error::inFile(path, 0, "append after an earlier write failed");
     const std::size_t n = ev.size();
     if (n == 0) return;
     const std::vector<TimeNs>& ts = ev.t();
@@ -205,6 +207,17 @@ struct EventH5Writer::Impl {
       if (ev.p()[i] > 1)
         reject("/events/p", "polarity of event " + std::to_string(i) + " is not 0 or 1");
 
+    try {
+      store(ev, offset, max_rel);
+    } catch (...) {
+      failed = true;
+      throw;
+    }
+  }
+
+  void store(const EventArray& ev, std::int64_t offset, std::int64_t max_rel) {
+    const std::size_t n = ev.size();
+    const std::vector<TimeNs>& ts = ev.t();
     offset_known = true;
     t_offset_us = offset;
     if (!wide && max_rel > kMaxU32) widen();
@@ -238,6 +251,7 @@ struct EventH5Writer::Impl {
 
   void close() {
     if (closed) throw Error::inFile(path, 0, "close() called twice");
+    if (failed) throw Error::inFile(path, 0, "close() after an earlier write failed");
     closed = true;
     flushEvents();
     pushMs(n_total);  // the entry after the last event's millisecond: all events

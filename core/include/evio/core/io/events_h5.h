@@ -108,7 +108,9 @@ class EventH5Writer {
   /// event is before t_offset or more than one day after it (/ms_to_idx has
   /// an entry per millisecond), when an event is outside the sensor (width and
   /// height known), when t_type is "uint32" and an event is 2^32 µs or more
-  /// after t_offset, or when writing fails.
+  /// after t_offset, or when polarity is not 0/1. A failed write (disk full)
+  /// also throws; the writer is then unusable (append and close throw) and
+  /// its destruction removes the temporary.
   void append(const EventArray& events);
 
   /// Writes the buffered events, /ms_to_idx, /t_offset and the attributes,

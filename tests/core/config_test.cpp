@@ -86,6 +86,14 @@ TEST(Config, WrongTypeNamesFieldAndLine) {
   EXPECT_THROW(config::fill(doc("exposure_s: .nan\n"), "", o), Error);
 }
 
+// Found by fuzz_config_yaml: a tagged or complex key made yaml-cpp throw its
+// own exception type instead of evio::Error.
+TEST(Config, NonScalarKeysAreAnError) {
+  OuterOptions o;
+  EXPECT_THROW(config::fill(doc("exposure_s: 0.02\n? [a, b]\n: 3\n"), "", o), Error);
+  EXPECT_THROW(config::fill(doc("exposure_s: 0.02\n!weights: [1, 2]\n"), "", o), Error);
+}
+
 TEST(Config, ValidateErrorNamesField) {
   OuterOptions o;
   try {

@@ -102,7 +102,8 @@ void throwAt(const Document& doc, const YAML::Node& node, const std::string& pat
 
 void Reader::rejectUnknownKeys() const {
   for (auto it = node_.begin(); it != node_.end(); ++it) {
-    const auto key = it->first.as<std::string>();
+    if (!it->first.IsScalar()) throwAt(doc_, it->first, path_, "keys must be plain strings");
+    const std::string& key = it->first.Scalar();
     if (!seen_.count(key)) {
       std::string known;
       for (const auto& k : seen_) known += (known.empty() ? "" : ", ") + k;

@@ -1,5 +1,8 @@
 #include "evio/core/io/text_scanner.h"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -10,10 +13,15 @@
 
 namespace evio::io {
 
-LineReader::LineReader(std::string path, std::size_t block_bytes)
-    : path_(std::move(path)), buffer_(block_bytes) {
+LineReader::LineReader(std::string path, std::size_t block_bytes) : path_(std::move(path)) {
   file_ = std::fopen(path_.c_str(), "rb");
   if (!file_) throw Error::inFile(path_, 0, std::string("cannot open file: ") + std::strerror(errno));
+  // A small file gets a small buffer; a long line still grows it (refill).
+  struct stat st {};
+  std::size_t size = block_bytes;
+  if (::fstat(::fileno(file_), &st) == 0 && st.st_size >= 0)
+    size = std::min(block_bytes, static_cast<std::size_t>(st.st_size) + 1);
+  buffer_.resize(std::max<std::size_t>(size, 256));
 }
 
 LineReader::~LineReader() {

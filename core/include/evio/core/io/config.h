@@ -166,7 +166,11 @@ void Writer::write(const T& field) {
 template <class Options>
 void fill(const Document& doc, const std::string& path, Options& options) {
   const YAML::Node node = path.empty() ? doc.root : child(doc, path);
-  if (node.IsDefined() && !node.IsNull()) detail::readValue(doc, node, path, options);
+  try {
+    if (node.IsDefined() && !node.IsNull()) detail::readValue(doc, node, path, options);
+  } catch (const YAML::Exception& e) {  // anything yaml-cpp itself rejects
+    throw Error::inFile(doc.file, e.mark.line + 1, "invalid YAML: " + e.msg);
+  }
   try {
     options.validate();
   } catch (const Error& e) {

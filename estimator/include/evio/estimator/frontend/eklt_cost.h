@@ -1,0 +1,58 @@
+#pragma once
+/// @file eklt_cost.h
+/// The EKLT alignment cost for one batch of events (Gehrig et al., IJCV 2019;
+/// eklt-vio-paper.tex, Eq. eklt-optimization).
+///
+/// Parameters p = (θ, tx, ty, φ): a rigid warp W(u; θ, t) = R(θ) u + t that
+/// maps a patch offset u (px, relative to the point around which the batch
+/// was accumulated) into the frame where the feature was initialised, and
+/// the flow direction v(φ) = (cos φ, sin φ) in the current image.
+///
+/// For every patch pixel u (row i, column j: u = (j − h, i − h), h = (P−1)/2):
+///   predicted increment  a(u) = −g(W(u))ᵀ R(θ) v(φ),   g = ∇L of the template
+///   (the template gradient seen in the current image is R(θ)ᵀ g, so
+///    −(Rᵀg)·v = −g·(R v); this is the linearised event generation model
+///    ΔL = −∇L·v Δt with the unobservable magnitude |v|Δt dropped);
+///   residual             r(u) = a(u)/‖a‖ − m(u),
+/// with m the measured increment (events with polarity ±1, bilinearly
+/// splatted) normalised to ‖m‖ = 1. The cost is Ceres' ½‖r‖² = 1 − ρ with
+/// ρ = âᵀm the normalised correlation, so the tracking quality 1 − cost/2
+/// equals (1 + ρ)/2 ∈ [0, 1].
+
+#include "evio/core/eigen_types.h"
+#include "evio/estimator/frontend/gradient_template.h"
+
+namespace evio::estimator {
+
+/// The data of one optimisation.
+struct EkltBatch {
+  const GradientTemplate* templ = nullptr;  ///< gradient of the initialisation frame
+  const float* measured = nullptr;          ///< P×P row-major, unit L2 norm
+  int patch_size = 0;                       ///< P (odd)
+};
+
+/// Cost and Gauss–Newton quantities at one parameter vector.
+struct EkltEvaluation {
+  double cost = 0.0;      ///< ½‖r‖²
+  double rho = 0.0;       ///< âᵀm
+  double abs_sum = 0.0;   ///< Σ|a(u)| (unnormalised), for the adaptive batch size
+  Mat4 jtj = Mat4::Zero();  ///< JᵀJ, J = ∂r/∂p
+  Vec4 jtr = Vec4::Zero();  ///< Jᵀr
+};
+
+/// Evaluates the cost (and JᵀJ, Jᵀr when `with_jacobian`) without forming r
+/// or J: with n = ‖a‖, â = a/n, s = Σ â ∂a/∂p:
+///   JᵀJ = (Σ ∂a/∂pᵀ∂a/∂p − s sᵀ)/n²,   Jᵀr = (ρ s − Σ m ∂a/∂p)/n.
+/// Returns false when the predicted increment vanishes (n = 0).
+bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out);
+
+/// The residual vector r (P² entries, row-major) and optionally d_r_d_p
+/// (P² × 4), formed explicitly; for tests and the numeric-Jacobian check.
+bool ekltResiduals(const EkltBatch& batch, const Vec4& p, VecX* r, MatX* d_r_d_p = nullptr);
+
+/// Where patch offset u maps, and the feature position this implies: the
+/// patch centre (u = 0) in the current image is the point that the warp
+/// sends to the template point x0, c = c_acc + R(θ)ᵀ (x0 − t).
+Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const Vec2& x0);
+
+}  // namespace evio::estimator

@@ -1,0 +1,72 @@
+#pragma once
+/// @file eklt_options.h
+/// Parameters of the EKLT tracker with the reference defaults
+/// (shared/reference/ALGORITHMS.md, EKLT tracker; 6-DOF sequences).
+
+#include <string>
+
+#include "evio/core/options.h"
+
+namespace evio::estimator {
+
+struct EkltOptions {
+  // Detection (Harris corners on frames).
+  int max_features = 60;             ///< corners detected up to this many live features
+  int min_features = 45;             ///< re-detect on a frame when fewer are alive
+  double harris_quality_level = 0.3; ///< relative to the strongest response
+  double harris_k = 0.04;            ///< Harris k
+  int harris_block_size = 3;         ///< Harris window, px
+  double min_distance_px = 9.0;      ///< between corners and around live patches
+
+  // Patch and batches.
+  int patch_size_px = 19;              ///< odd patch side P (17 on rotation-only; original EKLT 25)
+  double batch_displacement_px = 0.6;  ///< d: a batch holds about the events of a d-px motion
+  /// C in the batch size N = clamp(Σ_u |d ∇L(u)·v| / C, min, max): the
+  /// contrast threshold of the event camera (log units). With ∇L the true
+  /// log-image derivative (log_image.h) this makes N the number of events a
+  /// d-px motion produces.
+  double batch_contrast_threshold = 0.25;
+  int batch_min_events = 5;            ///< lower clamp of the batch size
+  int batch_max_events = 500;          ///< upper clamp of the batch size
+
+  // Optimisation.
+  std::string solver = "lm";           ///< "lm" (hand-written, hot path) or "ceres" (reference)
+  int max_iterations = 25;             ///< per batch
+  double min_tracking_quality = 0.6;   ///< lost below this 1 − cost/2 (the only outlier test)
+  double lost_border_px = 0.0;         ///< lost when the centre comes closer than this to the image edge
+
+  // Bootstrap (KLT between the detection frame and the next frame).
+  int bootstrap_window_px = 20;        ///< Lucas–Kanade window side
+  int bootstrap_pyramid_levels = 3;    ///< pyramid levels (OpenCV maxLevel = levels − 1)
+
+  // Prediction and images.
+  bool imu_prediction = false;         ///< predict each batch's start from the gyro (needs IMU and T_B_C)
+  double log_offset = 0.01;            ///< L = log(I/255 + offset) for 8-bit frames
+
+  template <class V>
+  void fields(V& v) {
+    v("max_features", max_features, "detect up to this many live features");
+    v("min_features", min_features, "re-detect when fewer features are alive");
+    v("harris_quality_level", harris_quality_level, "Harris quality level");
+    v("harris_k", harris_k, "Harris k");
+    v("harris_block_size", harris_block_size, "Harris block size, px");
+    v("min_distance_px", min_distance_px, "minimum distance between features, px");
+    v("patch_size_px", patch_size_px, "odd patch side, px");
+    v("batch_displacement_px", batch_displacement_px, "motion per batch, px");
+    v("batch_contrast_threshold", batch_contrast_threshold, "contrast threshold in the batch size");
+    v("batch_min_events", batch_min_events, "smallest batch");
+    v("batch_max_events", batch_max_events, "largest batch");
+    v("solver", solver, "lm or ceres");
+    v("max_iterations", max_iterations, "optimiser iterations per batch");
+    v("min_tracking_quality", min_tracking_quality, "lost below this tracking quality");
+    v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
+    v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");
+    v("bootstrap_pyramid_levels", bootstrap_pyramid_levels, "bootstrap KLT pyramid levels");
+    v("imu_prediction", imu_prediction, "predict feature positions from the gyro");
+    v("log_offset", log_offset, "offset in log(I/255 + offset)");
+  }
+
+  void validate() const;
+};
+
+}  // namespace evio::estimator

@@ -1,0 +1,112 @@
+#pragma once
+/// @file eklt_tracker.h
+/// EKLT (Gehrig et al., IJCV 2019) as used by EKLT-VIO (eklt-vio-paper.tex,
+/// Frontend): Harris corners detected on frames; per feature a template of
+/// the log-image gradient; events splatted bilinearly into a P×P patch
+/// around the feature; when the patch holds an adaptive number of events the
+/// rigid warp and the flow direction are optimised (eklt_cost.h), the batch
+/// is discarded (each batch used once) and the feature moves. The tracking
+/// quality threshold is the only outlier test. New features are bootstrapped
+/// by pyramidal KLT between their detection frame and the next frame.
+///
+/// Memory is fixed after construction (max_features slots, a per-pixel
+/// feature bitmask); processing an event allocates nothing.
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "evio/core/camera/camera.h"
+#include "evio/core/pose.h"
+#include "evio/estimator/frontend/eklt_options.h"
+#include "evio/estimator/frontend/eklt_solver.h"
+#include "evio/estimator/frontend/feature_grid.h"
+#include "evio/estimator/frontend/feature_tracker.h"
+#include "evio/estimator/frontend/gradient_template.h"
+#include "evio/estimator/frontend/gyro_predictor.h"
+
+namespace evio::estimator {
+
+/// Cumulative processing time by stage, seconds of wall time on this thread.
+struct EkltTiming {
+  double events_s = 0.0;        ///< addEvents in total (splatting + optimisation)
+  double optimisation_s = 0.0;  ///< inside the solver and its bookkeeping
+  double detection_s = 0.0;     ///< Harris detection and template extraction
+  double bootstrap_s = 0.0;     ///< bootstrap KLT
+  double frame_s = 0.0;         ///< addFrame in total (log image, gradients, the two above)
+  std::uint64_t events = 0;         ///< events received
+  std::uint64_t events_in_patches = 0;  ///< (event, feature) splats
+  std::uint64_t optimisations = 0;
+  std::uint64_t solver_iterations = 0;
+  /// Splatting and lookup: events_s − optimisation_s.
+  double splattingS() const { return events_s - optimisation_s; }
+};
+
+class EkltTracker final : public FeatureTracker {
+ public:
+  /// `camera`: the event camera (resolution; projection for the gyro
+  /// prediction). `T_B_C` is needed only when options.imu_prediction.
+  EkltTracker(const EkltOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
+  ~EkltTracker() override;
+
+  void addFrame(TimeNs t_ns, const cv::Mat& image) override;
+  using FeatureTracker::addEvents;
+  void addEvents(const EventArray& events, std::size_t begin, std::size_t end) override;
+  void addImu(const ImuSample& sample) override;
+  void drainTrackPoints(TrackPoints& out) override;
+  std::size_t numAlive() const override;
+  std::string_view name() const override { return "eklt"; }
+
+  /// Starts a feature by hand, bypassing detection and bootstrap: template
+  /// from (gx, gy) of a log image around x0 (the position at the template
+  /// frame), current position `uv` at time t_ns, rotation θ and flow angle φ.
+  /// Returns its id. For tests and for callers with their own detector.
+  FeatureId addFeature(const cv::Mat& log_image, const Vec2& x0, const Vec2& uv, TimeNs t_ns,
+                       double flow_angle_rad, double theta_rad = 0.0);
+
+  /// State of a live feature (nullopt when not alive).
+  struct FeatureState {
+    Vec2 uv;            ///< current position, px
+    double theta_rad;   ///< warp rotation
+    double flow_angle_rad;
+    int batch_size;     ///< events that trigger the next optimisation
+    double quality;
+  };
+  std::optional<FeatureState> feature(FeatureId id) const;
+
+  const EkltTiming& timing() const { return timing_; }
+  const EkltOptions& options() const { return options_; }
+
+ private:
+  struct Slot;
+  void splat(Slot& s, double x, double y, bool positive, TimeNs t_ns);
+  void optimise(int slot_index);
+  void activate(int slot_index, const Vec2& uv, TimeNs t_ns, double flow_angle);
+  void lose(int slot_index);
+  void free(int slot_index);
+  void resetPatch(Slot& s);
+  PixelRect patchRect(const Vec2& centre) const;
+  int freeSlot() const;
+  void assignTemplate(Slot& s, const cv::Mat& gx, const cv::Mat& gy, const Vec2& x0);
+  int batchSize(double abs_sum) const;
+
+  EkltOptions options_;
+  EkltSolverKind solver_;
+  EkltSolverSettings settings_;
+  Camera camera_;
+  int width_;
+  int height_;
+  int half_;                      // h = (P − 1)/2
+  int template_radius_;
+  std::vector<Slot> slots_;
+  FeatureGrid grid_;
+  std::unique_ptr<GyroPredictor> predictor_;
+  std::vector<float> measured_;   // normalised batch, P²
+  TrackPoints out_;
+  FeatureId next_id_ = 0;
+  cv::Mat previous_frame8_;
+  TimeNs previous_frame_t_ns_ = 0;
+  EkltTiming timing_;
+};
+
+}  // namespace evio::estimator

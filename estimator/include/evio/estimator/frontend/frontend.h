@@ -1,0 +1,77 @@
+#pragma once
+/// @file frontend.h
+/// The frontend as the pipelines and `evio track` use it: event pre-filters,
+/// an optional event-based image reconstruction, and one tracker (EKLT or
+/// KLT) behind the FeatureTracker interface. Inputs in time order
+/// (feature_tracker.h).
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "evio/core/camera/camera.h"
+#include "evio/core/pose.h"
+#include "evio/estimator/frontend/eklt_options.h"
+#include "evio/estimator/frontend/event_prefilter.h"
+#include "evio/estimator/frontend/feature_tracker.h"
+#include "evio/estimator/frontend/image_reconstructor.h"
+#include "evio/estimator/frontend/klt_tracker.h"
+
+namespace evio::estimator {
+
+struct FrontendOptions {
+  std::string tracker = "eklt";          ///< eklt | klt
+  std::string image_source = "frames";   ///< frames | reconstructed (from events)
+  EventPrefilterOptions prefilter;
+  EkltOptions eklt;
+  KltOptions klt;
+  ImageReconstructorOptions reconstruction;
+
+  template <class V>
+  void fields(V& v) {
+    v("tracker", tracker, "eklt or klt");
+    v("image_source", image_source, "frames or reconstructed");
+    v("prefilter", prefilter, "event pre-filters");
+    v("eklt", eklt, "EKLT tracker");
+    v("klt", klt, "KLT tracker");
+    v("reconstruction", reconstruction, "event-based image reconstruction");
+  }
+  void validate() const;
+};
+
+class Frontend {
+ public:
+  /// `camera` is the event camera (EKLT) or frame camera (KLT); `T_B_C` is
+  /// needed for the EKLT gyro prediction only.
+  Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
+  ~Frontend();
+
+  /// Events (non-decreasing time): pre-filtered, integrated into the
+  /// reconstruction (which may emit frames in between), then tracked.
+  void addEvents(const EventArray& events);
+  /// A sensor frame (CV_8UC1): to the tracker (image_source frames) or fused
+  /// into the reconstruction (image_source reconstructed).
+  void addFrame(TimeNs t_ns, const cv::Mat& image);
+  void addImu(const ImuSample& sample);
+
+  void drainTrackPoints(TrackPoints& out) { tracker_->drainTrackPoints(out); }
+  FeatureTracker& tracker() { return *tracker_; }
+  const FeatureTracker& tracker() const { return *tracker_; }
+
+  std::uint64_t numEventsSeen() const { return events_seen_; }
+  std::uint64_t numEventsKept() const { return events_kept_; }
+  std::uint64_t numReconstructedFrames() const { return reconstructed_frames_; }
+
+ private:
+  void track(const EventArray& events);
+  FrontendOptions options_;
+  std::unique_ptr<FeatureTracker> tracker_;
+  std::unique_ptr<EventPrefilter> prefilter_;
+  std::unique_ptr<ImageReconstructor> reconstructor_;
+  EventArray filtered_;
+  std::uint64_t events_seen_ = 0;
+  std::uint64_t events_kept_ = 0;
+  std::uint64_t reconstructed_frames_ = 0;
+};
+
+}  // namespace evio::estimator

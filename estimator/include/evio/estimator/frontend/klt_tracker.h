@@ -1,0 +1,77 @@
+#pragma once
+/// @file klt_tracker.h
+/// The frame-based KLT-VIO frontend (ALGORITHMS.md, KLT-VIO): FAST corners,
+/// pyramidal Lucas–Kanade between consecutive frames, and RANSAC on the
+/// fundamental matrix (8-point model) to reject outliers. The RANSAC
+/// threshold is a distance in pixels of an ideal pinhole camera with the
+/// calibrated focal length: points are undistorted with the camera model to
+/// normalised coordinates and scaled by fx before RANSAC, so the threshold
+/// means the same whatever the distortion. Track points are emitted at frame
+/// times; events are ignored.
+
+#include <vector>
+
+#include "evio/core/camera/camera.h"
+#include "evio/core/options.h"
+#include "evio/estimator/frontend/feature_tracker.h"
+
+namespace evio::estimator {
+
+struct KltOptions {
+  int max_features = 60;             ///< detect up to this many live features
+  int min_features = 45;             ///< re-detect when fewer are alive
+  int fast_threshold = 20;           ///< FAST threshold, grey levels
+  bool fast_nonmax_suppression = true;
+  double min_distance_px = 9.0;      ///< between features
+  int border_px = 10;                ///< no detection this close to the edge
+  int window_px = 21;                ///< Lucas–Kanade window side
+  int pyramid_levels = 3;            ///< pyramid levels (OpenCV maxLevel = levels − 1)
+  int max_iterations = 30;           ///< Lucas–Kanade iterations per level
+  double lk_epsilon = 0.01;          ///< Lucas–Kanade stopping step, px
+  bool ransac = true;                ///< fundamental-matrix RANSAC
+  double ransac_threshold_px = 0.6;  ///< epipolar distance, px of the undistorted image
+  double ransac_confidence = 0.99;   ///< RANSAC confidence
+
+  template <class V>
+  void fields(V& v) {
+    v("max_features", max_features, "detect up to this many live features");
+    v("min_features", min_features, "re-detect when fewer are alive");
+    v("fast_threshold", fast_threshold, "FAST threshold, grey levels");
+    v("fast_nonmax_suppression", fast_nonmax_suppression, "FAST non-maximum suppression");
+    v("min_distance_px", min_distance_px, "minimum distance between features, px");
+    v("border_px", border_px, "detection border, px");
+    v("window_px", window_px, "Lucas-Kanade window side, px");
+    v("pyramid_levels", pyramid_levels, "pyramid levels");
+    v("max_iterations", max_iterations, "Lucas-Kanade iterations per level");
+    v("lk_epsilon", lk_epsilon, "Lucas-Kanade stopping step, px");
+    v("ransac", ransac, "fundamental-matrix RANSAC");
+    v("ransac_threshold_px", ransac_threshold_px, "RANSAC threshold, px of the undistorted image");
+    v("ransac_confidence", ransac_confidence, "RANSAC confidence");
+  }
+  void validate() const;
+};
+
+class KltTracker final : public FeatureTracker {
+ public:
+  KltTracker(const KltOptions& options, const Camera& camera);
+
+  void addFrame(TimeNs t_ns, const cv::Mat& image) override;
+  using FeatureTracker::addEvents;
+  void addEvents(const EventArray&, std::size_t, std::size_t) override {}
+  void addImu(const ImuSample&) override {}
+  void drainTrackPoints(TrackPoints& out) override;
+  std::size_t numAlive() const override { return ids_.size(); }
+  std::string_view name() const override { return "klt"; }
+
+ private:
+  KltOptions options_;
+  Camera camera_;
+  cv::Mat previous_;
+  TimeNs previous_t_ns_ = 0;
+  std::vector<FeatureId> ids_;
+  std::vector<Vec2> points_;
+  FeatureId next_id_ = 0;
+  TrackPoints out_;
+};
+
+}  // namespace evio::estimator

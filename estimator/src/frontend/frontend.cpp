@@ -1,0 +1,71 @@
+#include "evio/estimator/frontend/frontend.h"
+
+#include "evio/core/error.h"
+#include "evio/estimator/frontend/eklt_tracker.h"
+
+namespace evio::estimator {
+
+void FrontendOptions::validate() const {
+  requireField(tracker == "eklt" || tracker == "klt", "tracker", "must be eklt or klt (got '" + tracker + "')");
+  requireField(image_source == "frames" || image_source == "reconstructed", "image_source",
+               "must be frames or reconstructed (got '" + image_source + "')");
+  prefilter.validate();
+  eklt.validate();
+  klt.validate();
+  reconstruction.validate();
+}
+
+Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
+    : options_(options) {
+  options_.validate();
+  if (options_.tracker == "eklt")
+    tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C);
+  else
+    tracker_ = std::make_unique<KltTracker>(options_.klt, camera);
+  if (!options_.prefilter.passThrough())
+    prefilter_ = std::make_unique<EventPrefilter>(options_.prefilter, camera.width(), camera.height());
+  if (options_.image_source == "reconstructed")
+    reconstructor_ = std::make_unique<ImageReconstructor>(options_.reconstruction, camera.width(), camera.height());
+}
+
+Frontend::~Frontend() = default;
+
+void Frontend::addEvents(const EventArray& events) {
+  events_seen_ += events.size();
+  if (prefilter_) {
+    prefilter_->filter(events, 0, events.size(), &filtered_);
+    track(filtered_);
+  } else {
+    track(events);
+  }
+}
+
+void Frontend::track(const EventArray& events) {
+  events_kept_ += events.size();
+  if (!reconstructor_) {
+    tracker_->addEvents(events, 0, events.size());
+    return;
+  }
+  std::size_t begin = 0;
+  while (begin < events.size()) {
+    const std::size_t end = reconstructor_->addEvents(events, begin, events.size());
+    tracker_->addEvents(events, begin, end);
+    if (reconstructor_->frameDue()) {
+      const TimeNs t = reconstructor_->dueTime();
+      tracker_->addFrame(t, reconstructor_->image(t));
+      ++reconstructed_frames_;
+    }
+    begin = end;
+  }
+}
+
+void Frontend::addFrame(TimeNs t_ns, const cv::Mat& image) {
+  if (reconstructor_)
+    reconstructor_->addFrame(t_ns, image);
+  else
+    tracker_->addFrame(t_ns, image);
+}
+
+void Frontend::addImu(const ImuSample& sample) { tracker_->addImu(sample); }
+
+}  // namespace evio::estimator

@@ -53,28 +53,32 @@ YAML::Node nodeAt(const YAML::Node& node, const std::string& field) {
   throw Error(config::where(doc, at, path) + ": " + path + "." + msg);
 }
 
-/// Reports an unknown or missing `key` (a type tag) before the element is
-/// read, so that the message is about the type and not about its fields.
-void checkTag(const Document& doc, const YAML::Node& list, const std::string& list_name,
-              const std::string& key, const std::function<bool(const std::string&)>& known,
-              const std::string& known_list, const std::string& what, bool required) {
-  if (!list.IsDefined() || !list.IsSequence()) return;  // the reader reports the shape
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const YAML::Node item = list[i];
-    const std::string path = list_name + "[" + std::to_string(i) + "]";
-    if (!item.IsMap()) continue;
-    const YAML::Node tag = item[key];
-    if (!tag.IsDefined() || tag.IsNull()) {
-      if (required)
-        throw Error(config::where(doc, item, path) + ": " + path + "." + key + ": missing (known " +
-                    what + "s: " + known_list + ")");
-      continue;
-    }
-    if (!tag.IsScalar() || !known(tag.Scalar()))
-      throw Error(config::where(doc, tag, path + "." + key) + ": " + path + "." + key + ": unknown " +
-                  what + " '" + (tag.IsScalar() ? tag.Scalar() : std::string("?")) + "' (known: " +
-                  known_list + ")");
+/// Reports an unknown or missing `key` (a type tag) of the map `item` at
+/// `path` before the item is read, so that the message is about the type and
+/// not about its fields.
+void checkTag(const Document& doc, const YAML::Node& item, const std::string& path, const std::string& key,
+              const std::function<bool(const std::string&)>& known, const std::string& known_list,
+              const std::string& what, bool required) {
+  if (!item.IsDefined() || !item.IsMap()) return;  // the reader reports the shape
+  const YAML::Node tag = item[key];
+  if (!tag.IsDefined() || tag.IsNull()) {
+    if (required)
+      throw Error(config::where(doc, item, path) + ": " + path + "." + key + ": missing (known " + what +
+                  "s: " + known_list + ")");
+    return;
   }
+  if (!tag.IsScalar() || !known(tag.Scalar()))
+    throw Error(config::where(doc, tag, path + "." + key) + ": " + path + "." + key + ": unknown " + what + " '" +
+                (tag.IsScalar() ? tag.Scalar() : std::string("?")) + "' (known: " + known_list + ")");
+}
+
+/// checkTag for every item of the list `list_name`.
+void checkTags(const Document& doc, const YAML::Node& list, const std::string& list_name, const std::string& key,
+               const std::function<bool(const std::string&)>& known, const std::string& known_list,
+               const std::string& what, bool required) {
+  if (!list.IsDefined() || !list.IsSequence()) return;
+  for (std::size_t i = 0; i < list.size(); ++i)
+    checkTag(doc, list[i], list_name + "[" + std::to_string(i) + "]", key, known, known_list, what, required);
 }
 
 bool oneOf(const std::string& s, std::initializer_list<const char*> names) {
@@ -104,21 +108,17 @@ SceneDescription loadSceneDocument(const Document& doc, const std::string& base_
     return oneOf(t, {"constant", "noise", "image", "shapes", "collage", "checker"});
   };
   const auto known_model = [](const std::string& t) { return oneOf(t, {"lambertian", "oren_nayar"}); };
-  checkTag(doc, root["sources"], "sources", "type", known_source, SourceOptions::knownTypes(),
+  checkTags(doc, root["sources"], "sources", "type", known_source, SourceOptions::knownTypes(),
            "source type", true);
-  checkTag(doc, root["lights"], "lights", "type", known_light, LightOptions::knownTypes(),
+  checkTags(doc, root["lights"], "lights", "type", known_light, LightOptions::knownTypes(),
            "light type", true);
-  checkTag(doc, root["materials"], "materials", "model", known_model, "lambertian, oren_nayar",
+  checkTags(doc, root["materials"], "materials", "model", known_model, "lambertian, oren_nayar",
            "reflectance model", false);
   if (root["materials"].IsSequence())
-    for (std::size_t i = 0; i < root["materials"].size(); ++i) {
-      const YAML::Node albedo = root["materials"][i]["albedo"];
-      if (!albedo.IsDefined() || !albedo.IsMap()) continue;
-      YAML::Node wrapped(YAML::NodeType::Sequence);
-      wrapped.push_back(albedo);
-      checkTag(doc, wrapped, "materials[" + std::to_string(i) + "].albedo", "type", known_texture,
-               TextureOptions::knownTypes(), "texture type", false);
-    }
+    for (std::size_t i = 0; i < root["materials"].size(); ++i)
+      if (root["materials"][i].IsMap())
+        checkTag(doc, root["materials"][i]["albedo"], "materials[" + std::to_string(i) + "].albedo", "type",
+                 known_texture, TextureOptions::knownTypes(), "texture type", false);
 
   SceneDescription d;
   d.file = doc.file;

@@ -1,5 +1,8 @@
 #include "evio/scenes/source_options.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace evio::scenes {
 
 namespace {
@@ -95,12 +98,17 @@ void TubeParams::validate() const {
   requireInRange("roughness", roughness, 0.0, 0.3);
   requirePositive("roughness_wavelength_m", roughness_wavelength_m);
   requireNonNegative("meander_m", meander_m);
+  requireField(surface_height_m > floor_depth_m + 0.5 * height_m + 1.0, "surface_height_m",
+               "must leave at least 1 m of rock above the tube");
+  requireNonNegative("surface_relief_m", surface_relief_m);
+  requirePositive("pit_length_m", pit_length_m);
+  requirePositive("pit_width_m", pit_width_m);
+  requireNonNegative("margin_m", margin_m);
   requirePositive("cell_m", cell_m);
-  requireField(length_m / cell_m * (width_m + height_m) * 2.0 / cell_m < 5e7, "cell_m",
-               "too many grid cells");
-  requireInRange("collapse_center_m", collapse_center_m, 0.0, length_m);
-  requireNonNegative("collapse_length_m", collapse_length_m);
-  requireNonNegative("collapse_width_m", collapse_width_m);
+  const double cells = (length_m + pit_length_m + margin_m) / cell_m *
+                       (std::max(pit_width_m, width_m) + 2.0 * margin_m) / cell_m *
+                       (surface_height_m + 2.0) / cell_m;
+  requireField(cells < 1.5e8, "cell_m", "too many grid cells (more than 1.5e8)");
 }
 
 void SourceOptions::validate() const {

@@ -6,7 +6,8 @@
 /// changes between renders: a static scene renders identically every time,
 /// whatever the thread count.
 ///
-/// For vertex x with normal n, pass b = 1..B computes
+/// For vertex x with normal n (rays start at x + δn, δ = 5 % of the mean
+/// edge length at x), pass b = 1..B computes
 ///   E_b(x) = π/N Σ_{i=1}^{N} L_{b−1}(x, ω_i)
 /// over N fixed cosine-distributed directions ω_i about n (a Hammersley set,
 /// turned about n by an angle hashed from x's position so neighbouring

@@ -130,8 +130,10 @@ class Scene {
   float interpolate(const SurfaceHit& hit, const std::vector<std::vector<float>>& cache) const;
 
   /// Throws Error naming the source (file:line) when the point p_W lies
-  /// inside a solid source: one of 64 fixed rays from p_W first meets the back
-  /// of a solid source's surface.
+  /// inside a solid source: of 64 fixed rays from p_W (a Fibonacci sphere),
+  /// more than half of those that hit anything first meet the back of that
+  /// source's surface (inside a closed solid all do; below a terrain all
+  /// upward rays do and the others escape).
   void checkViewpoint(const Vec3& p_W) const;
 
  private:

@@ -9,7 +9,7 @@
 ///   rocks      scattered rocks on the ground or on another source
 ///   heightmap  a terrain from an EXR, 16-bit PNG or GeoTIFF raster
 ///   mesh       a triangle mesh from an OBJ or PLY file
-///   tube       a lava tube with an irregular wall and a roof collapse
+///   tube       a lava tube entered from a collapse pit (lava_tube.h)
 ///
 /// Placement: `position_m` and `rotation_deg` = [roll, pitch, yaw] map local
 /// to world coordinates as p_W = R p_local + position_m with
@@ -17,8 +17,8 @@
 ///
 /// Surface coordinates uv (m) for uv-based textures: plane u = x + w/2,
 /// v = h/2 − y (image top at the local +y edge); box faces alike per face;
-/// terrain and heightmap the world (x, y); tube (distance along the axis,
-/// arc length around it); mesh the file's texture coordinates × uv_size_m.
+/// terrain, heightmap and tube the world (x, y); mesh the file's texture
+/// coordinates × uv_size_m.
 
 #include <string>
 #include <vector>
@@ -157,34 +157,38 @@ struct MeshParams {
 };
 
 struct TubeParams {
-  Vec3 position_m = Vec3::Zero();       ///< axis start (the axis runs along local +x)
-  double yaw_deg = 0.0;                 ///< heading of the axis
-  double length_m = 40.0;               ///< axis length
-  double width_m = 8.0;                 ///< mean full width
-  double height_m = 6.0;                ///< mean full height (before the floor cut)
-  double floor_depth_m = 1.8;           ///< floor level below the axis
+  Vec3 position_m = Vec3::Zero();       ///< floor point on the axis at the mouth
+  double yaw_deg = 0.0;                 ///< heading into the tube (0: +x)
+  double length_m = 50.0;               ///< tube length from the mouth
+  double width_m = 9.0;                 ///< mean width of the elliptic section
+  double height_m = 7.0;                ///< mean height of the elliptic section
+  double floor_depth_m = 2.0;           ///< floor level below the section's centre
   double roughness = 0.1;               ///< relative wall irregularity
   double roughness_wavelength_m = 2.5;  ///< wavelength of the wall irregularity
   double meander_m = 1.5;               ///< lateral wander of the axis
-  double cell_m = 0.25;                 ///< grid step on the wall
-  double collapse_center_m = 8.0;       ///< axis distance of the roof collapse centre
-  double collapse_length_m = 7.0;       ///< extent of the opening along the axis
-  double collapse_width_m = 6.0;        ///< extent of the opening across (arc length)
+  double surface_height_m = 10.0;       ///< ground surface above the mouth's floor
+  double surface_relief_m = 0.6;        ///< relief amplitude of the surface
+  double pit_length_m = 30.0;           ///< collapse pit before the mouth, along the axis
+  double pit_width_m = 18.0;            ///< collapse pit width
+  double margin_m = 10.0;               ///< surface extent around the pit
+  double cell_m = 0.25;                 ///< grid step of the surface extraction
   template <class V>
   void fields(V& v) {
-    v("position_m", position_m, "axis start (m)");
-    v("yaw_deg", yaw_deg, "axis heading (deg)");
-    v("length_m", length_m, "length (m)");
-    v("width_m", width_m, "mean full width (m)");
-    v("height_m", height_m, "mean full height (m)");
-    v("floor_depth_m", floor_depth_m, "floor below the axis (m)");
+    v("position_m", position_m, "floor point on the axis at the mouth (m)");
+    v("yaw_deg", yaw_deg, "heading into the tube (deg)");
+    v("length_m", length_m, "tube length (m)");
+    v("width_m", width_m, "section width (m)");
+    v("height_m", height_m, "section height (m)");
+    v("floor_depth_m", floor_depth_m, "floor below the section centre (m)");
     v("roughness", roughness, "relative wall irregularity");
     v("roughness_wavelength_m", roughness_wavelength_m, "irregularity wavelength (m)");
     v("meander_m", meander_m, "lateral wander of the axis (m)");
+    v("surface_height_m", surface_height_m, "surface above the mouth floor (m)");
+    v("surface_relief_m", surface_relief_m, "surface relief (m)");
+    v("pit_length_m", pit_length_m, "collapse pit length (m)");
+    v("pit_width_m", pit_width_m, "collapse pit width (m)");
+    v("margin_m", margin_m, "surface extent around the pit (m)");
     v("cell_m", cell_m, "grid step (m)");
-    v("collapse_center_m", collapse_center_m, "collapse centre along the axis (m)");
-    v("collapse_length_m", collapse_length_m, "opening extent along the axis (m)");
-    v("collapse_width_m", collapse_width_m, "opening extent across (m)");
   }
   void validate() const;
 };

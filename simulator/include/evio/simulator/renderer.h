@@ -1,0 +1,91 @@
+#pragma once
+/// @file renderer.h
+/// The HDR renderer: per-pixel radiance (W/(m²·sr)), depth, surface normal
+/// and motion field of a scenes::Scene seen by a core camera model at a pose.
+///
+/// Rays: pixel (x, y) is the point uv = (x, y) (pixel centres at integer
+/// coordinates, camera_common.h); its ray leaves the camera centre along
+/// R_W_C · b with b = camera.unproject(uv) (distortion included). The bearing
+/// table is computed once per Renderer. With supersampling n > 1 the
+/// radiance is the mean over n × n rays at uv + ((i + ½)/n − ½, (j + ½)/n − ½);
+/// depth, normal and flow always come from the centre ray.
+///
+/// Tracing: the image is cut into square tiles processed in parallel; each
+/// tile sends its camera rays to Embree as one stream (rtcIntersect1M with
+/// the coherent flag), then one stream of occlusion rays (rtcOccluded1M), one
+/// per hit and shadow light; shading follows scene.h. Every pixel depends on
+/// nothing but its own rays, so the output is bit-identical whatever the
+/// number of threads.
+
+#include <opencv2/core/mat.hpp>
+#include <vector>
+
+#include "evio/core/camera/camera.h"
+#include "evio/core/options.h"
+#include "evio/core/pose.h"
+#include "evio/scenes/scene.h"
+#include "evio/simulator/motion_field.h"
+
+namespace evio::simulator {
+
+struct RendererOptions {
+  int threads = 0;           ///< render threads, 0 = all cores (output does not depend on it)
+  int tile_px = 16;          ///< tile edge length in pixels
+  int supersampling = 1;     ///< n: n × n radiance rays per pixel
+  bool check_viewpoint = true;  ///< throw when the camera is inside a solid source
+
+  template <class V>
+  void fields(V& v) {
+    v("threads", threads, "render threads, 0 = all cores");
+    v("tile_px", tile_px, "tile edge length (px)");
+    v("supersampling", supersampling, "n x n radiance rays per pixel");
+    v("check_viewpoint", check_viewpoint, "error when the camera is inside geometry");
+  }
+  void validate() const {
+    requireInRange("threads", threads, 0, 1024);
+    requireInRange("tile_px", tile_px, 1, 256);
+    requireInRange("supersampling", supersampling, 1, 8);
+  }
+};
+
+/// One rendered view. Images are width × height of the camera.
+struct RenderOutput {
+  cv::Mat radiance;  ///< CV_32FC1, W/(m²·sr); sky radiance for upward rays that leave the scene
+  cv::Mat depth;     ///< CV_32FC1, z of the surface point in C (m, along the optical axis);
+                     ///< +inf where the ray leaves the scene; NaN where the pixel has no ray
+  cv::Mat normal;    ///< CV_32FC3, unit shading normal in W facing the camera; 0 where no surface
+  cv::Mat flow;      ///< CV_32FC2, (u̇, v̇) in px/s (motion_field.h); empty without a velocity
+};
+
+class Renderer {
+ public:
+  /// Keeps references to `scene` (which must outlive the renderer); copies the camera.
+  Renderer(const scenes::Scene& scene, const Camera& camera, const RendererOptions& options = {});
+
+  /// Renders the view from T_W_C (camera C in world W). With `velocity`, also
+  /// the motion field. Throws Error (naming the source) when
+  /// check_viewpoint is on and the camera is inside a solid source.
+  RenderOutput render(const Pose& T_W_C, const CameraVelocity* velocity = nullptr) const;
+
+  /// Unit bearing in C of the centre ray of pixel (x, y); NaN when the model
+  /// cannot unproject that pixel.
+  Eigen::Vector3f bearing(int x, int y) const {
+    return bearings_[static_cast<std::size_t>(y) * static_cast<std::size_t>(camera_.width()) +
+                     static_cast<std::size_t>(x)];
+  }
+
+  const Camera& camera() const { return camera_; }
+  const RendererOptions& options() const { return options_; }
+
+ private:
+  void renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out) const;
+
+  const scenes::Scene& scene_;
+  Camera camera_;
+  RendererOptions options_;
+  std::vector<Eigen::Vector3f> bearings_;     ///< centre ray per pixel, row-major
+  std::vector<Eigen::Vector3f> sub_bearings_; ///< n² rays per pixel when supersampling > 1
+  float pixel_angle_rad_ = 0.0f;              ///< ≈ 1 / fx, for the texture footprint
+};
+
+}  // namespace evio::simulator

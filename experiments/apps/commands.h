@@ -8,6 +8,6 @@
 namespace evio::apps {
 
 void addInfoCommand(CLI::App& app);
-void addRenderCommand(CLI::App& app);
+void addTrajectoryCommand(CLI::App& app);
 
 }  // namespace evio::apps

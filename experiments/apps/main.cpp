@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "evio 0.1.0");
   evio::apps::addInfoCommand(app);
-  evio::apps::addRenderCommand(app);
+  evio::apps::addTrajectoryCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

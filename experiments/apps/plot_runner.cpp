@@ -1,0 +1,36 @@
+#include "plot_runner.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace evio::apps {
+
+std::string runPlotScript(const std::string& script, const std::vector<std::string>& args) {
+  const char* env_dir = std::getenv("EVIO_PLOTS_DIR");
+  const std::filesystem::path dir = env_dir ? env_dir : EVIO_PLOTS_DIR;
+  const std::string path = (dir / script).string();
+  const char* python = "/usr/bin/python3";
+  if (!std::filesystem::exists(path)) return "plot script not found: " + path;
+  if (::access(python, X_OK) != 0) return "plot skipped: /usr/bin/python3 is missing (scripts/install_deps.sh installs it)";
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(python));
+  argv.push_back(const_cast<char*>(path.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) return "plot failed: cannot fork";
+  if (pid == 0) {
+    ::execv(python, argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  if (::waitpid(pid, &status, 0) < 0) return "plot failed: waitpid";
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    return "plot failed: " + path + " exited with status " + std::to_string(WEXITSTATUS(status));
+  return {};
+}
+
+}  // namespace evio::apps

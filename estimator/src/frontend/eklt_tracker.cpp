@@ -41,6 +41,8 @@ void EkltOptions::validate() const {
   requireField(batch_max_events >= batch_min_events, "batch_max_events", "must be >= batch_min_events");
   parseEkltSolverKind(solver);
   requireField(max_iterations >= 1, "max_iterations", "must be >= 1");
+  requireNonNegative("function_tolerance", function_tolerance);
+  requireNonNegative("parameter_tolerance", parameter_tolerance);
   requireInRange("min_tracking_quality", min_tracking_quality, 0.0, 1.0);
   requireNonNegative("lost_border_px", lost_border_px);
   requireField(bootstrap_window_px >= 3, "bootstrap_window_px", "must be >= 3");
@@ -84,6 +86,8 @@ EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::
       grid_(camera.width(), camera.height(), options.max_features) {
   options_.validate();
   settings_.max_iterations = options_.max_iterations;
+  settings_.function_tolerance = options_.function_tolerance;
+  settings_.parameter_tolerance = options_.parameter_tolerance;
   if (options_.imu_prediction) {
     require(T_B_C.has_value(), "EkltTracker: imu_prediction needs T_B_C");
     predictor_ = std::make_unique<GyroPredictor>(camera_, *T_B_C);

@@ -32,6 +32,12 @@ struct EkltOptions {
   // Optimisation.
   std::string solver = "lm";           ///< "lm" (hand-written, hot path) or "ceres" (reference)
   int max_iterations = 25;             ///< per batch
+  /// Stop when |Δcost| ≤ tol · cost (Ceres' function_tolerance).
+  double function_tolerance = 1e-6;
+  /// Stop when ‖δp‖ ≤ tol · (‖p‖ + tol) (Ceres' parameter_tolerance); ‖p‖ is
+  /// dominated by the template position (~10²  px), so 1e-5 stops steps
+  /// below ~10⁻³ px.
+  double parameter_tolerance = 1e-8;
   double min_tracking_quality = 0.6;   ///< lost below this 1 − cost/2 (the only outlier test)
   double lost_border_px = 0.0;         ///< lost when the centre comes closer than this to the image edge
 
@@ -58,6 +64,8 @@ struct EkltOptions {
     v("batch_max_events", batch_max_events, "largest batch");
     v("solver", solver, "lm or ceres");
     v("max_iterations", max_iterations, "optimiser iterations per batch");
+    v("function_tolerance", function_tolerance, "relative cost change that stops the optimiser");
+    v("parameter_tolerance", parameter_tolerance, "relative step that stops the optimiser");
     v("min_tracking_quality", min_tracking_quality, "lost below this tracking quality");
     v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
     v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");

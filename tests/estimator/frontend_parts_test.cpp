@@ -1,0 +1,162 @@
+// Event pre-filters, the complementary-filter reconstruction and the gyro
+// prediction, each against exact expectations.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "evio/core/so3.h"
+#include "evio/estimator/frontend/event_prefilter.h"
+#include "evio/estimator/frontend/gyro_predictor.h"
+#include "evio/estimator/frontend/image_reconstructor.h"
+
+namespace evio::estimator {
+namespace {
+
+TEST(EventPrefilter, RefractoryPeriodDropsEventsWithinTauOfTheLastKeptOne) {
+  EventPrefilterOptions o;
+  o.refractory_period_s = 0.010;
+  EventPrefilter filter(o, 4, 4);
+  EventArray in, out;
+  // Pixel (1, 1) at 0, 5, 9.999, 10, 15, 25 ms; pixel (2, 3) at 6 ms.
+  for (double ms : {0.0, 5.0, 9.999, 10.0}) in.push_back(secondsToNs(ms * 1e-3), 1, 1, true);
+  in.push_back(secondsToNs(6e-3), 2, 3, false);
+  for (double ms : {15.0, 25.0}) in.push_back(secondsToNs(ms * 1e-3), 1, 1, true);
+  filter.filter(in, 0, in.size(), &out);
+  std::vector<TimeNs> kept(out.t().begin(), out.t().end());
+  // 0 kept; 5, 9.999 dropped; 10 kept (exactly τ after 0); 6 ms other pixel kept;
+  // 15 dropped (5 ms after 10); 25 kept.
+  EXPECT_EQ(kept, (std::vector<TimeNs>{0, secondsToNs(10e-3), secondsToNs(6e-3), secondsToNs(25e-3)}));
+  EXPECT_EQ(filter.numSeen(), 7u);
+  EXPECT_EQ(filter.numKept(), 4u);
+}
+
+TEST(EventPrefilter, RandomFilterKeepsOneInRAndIsSeeded) {
+  EventPrefilterOptions o;
+  o.random_keep_one_in = 4;
+  EventArray in, a, b;
+  for (int i = 0; i < 40000; ++i) in.push_back(i, static_cast<std::uint16_t>(i % 8), 0, true);
+  EventPrefilter fa(o, 8, 1), fb(o, 8, 1);
+  fa.filter(in, 0, in.size(), &a);
+  fb.filter(in, 0, in.size(), &b);
+  EXPECT_EQ(a, b);  // same seed, same events
+  // Binomial(40000, 1/4): mean 10000, σ ≈ 86.6; 5σ bounds.
+  EXPECT_NEAR(static_cast<double>(a.size()), 10000.0, 5 * 86.6);
+  o.random_seed = 2;
+  EventPrefilter fc(o, 8, 1);
+  EventArray c;
+  fc.filter(in, 0, in.size(), &c);
+  EXPECT_NE(a, c);
+  EventArray outside;
+  outside.push_back(0, 9, 0, true);
+  EXPECT_THROW(fa.filter(outside, 0, 1, &a), Error);
+}
+
+TEST(ImageReconstructor, HighPassFilterStepsAndDecaysExactly) {
+  ImageReconstructorOptions o;
+  o.cutoff_frequency_rad_s = 2.0;
+  o.contrast_threshold = 0.3;
+  o.fuse_frames = false;
+  o.output_every_events = 0;
+  ImageReconstructor rec(o, 3, 2);
+  EventArray ev;
+  ev.push_back(secondsToNs(1.0), 1, 0, true);
+  ev.push_back(secondsToNs(1.5), 1, 0, true);
+  ev.push_back(secondsToNs(1.5), 2, 1, false);
+  EXPECT_EQ(rec.addEvents(ev, 0, ev.size()), ev.size());
+  const cv::Mat img = rec.image(secondsToNs(2.0));
+  // Pixel (1,0): 0.3 at 1.0 s, decays e^{-2·0.5}, +0.3 at 1.5 s, decays e^{-2·0.5}.
+  const double expected = (0.3 * std::exp(-1.0) + 0.3) * std::exp(-1.0);
+  EXPECT_NEAR(img.at<float>(0, 1), expected, 1e-6);
+  EXPECT_NEAR(img.at<float>(1, 2), -0.3 * std::exp(-1.0), 1e-6);
+  EXPECT_EQ(img.at<float>(0, 0), 0.0f);
+}
+
+TEST(ImageReconstructor, FusesUnsaturatedFramesAndKeepsEventsWhereSaturated) {
+  ImageReconstructorOptions o;
+  o.cutoff_frequency_rad_s = 5.0;
+  o.contrast_threshold = 0.2;
+  o.output_every_events = 0;
+  ImageReconstructor rec(o, 2, 1);
+  cv::Mat frame(1, 2, CV_8UC1);
+  frame.at<std::uint8_t>(0, 0) = 100;  // usable
+  frame.at<std::uint8_t>(0, 1) = 255;  // saturated: not fused
+  rec.addFrame(0, frame);
+  EventArray ev;
+  ev.push_back(secondsToNs(0.1), 0, 0, true);
+  ev.push_back(secondsToNs(0.1), 1, 0, true);
+  rec.addEvents(ev, 0, ev.size());
+  const cv::Mat img = rec.image(secondsToNs(0.3));
+  const double lf = std::log(100.0 / 255.0 + 0.01);
+  // Pixel 0: the estimate starts at 0 and relaxes towards L_F from t = 0,
+  // steps by +C at 0.1 s, then relaxes for 0.2 s more.
+  const double l01 = lf + (0.0 - lf) * std::exp(-5.0 * 0.1) + 0.2;
+  EXPECT_NEAR(img.at<float>(0, 0), lf + (l01 - lf) * std::exp(-5.0 * 0.2), 1e-5);
+  // Pixel 1 keeps L_F = 0 (saturated frame), so it is the high-pass filter.
+  EXPECT_NEAR(img.at<float>(0, 1), 0.2 * std::exp(-5.0 * 0.2), 1e-6);
+}
+
+TEST(ImageReconstructor, EmitsFramesEveryNEventsAndAtARate) {
+  ImageReconstructorOptions o;
+  o.output_every_events = 3;
+  ImageReconstructor rec(o, 2, 2);
+  EventArray ev;
+  for (int i = 0; i < 7; ++i) ev.push_back(1000 * i, 0, 0, i % 2 == 0);
+  std::vector<TimeNs> due;
+  std::size_t begin = 0;
+  while (begin < ev.size()) {
+    begin = rec.addEvents(ev, begin, ev.size());
+    if (rec.frameDue()) {
+      due.push_back(rec.dueTime());
+      rec.image(rec.dueTime());
+    }
+  }
+  EXPECT_EQ(due, (std::vector<TimeNs>{2000, 5000}));
+
+  ImageReconstructorOptions r;
+  r.output_every_events = 0;
+  r.output_rate_hz = 1000.0;  // every 1 ms of event time
+  ImageReconstructor rate(r, 2, 2);
+  EventArray ev2;
+  for (int i = 0; i <= 10; ++i) ev2.push_back(secondsToNs(i * 0.4e-3), 1, 1, true);
+  due.clear();
+  begin = 0;
+  while (begin < ev2.size()) {
+    begin = rate.addEvents(ev2, begin, ev2.size());
+    if (rate.frameDue()) {
+      due.push_back(rate.dueTime());
+      rate.image(rate.dueTime());
+    }
+  }
+  // First event at 0 starts the clock: frames at the first events ≥ 1 ms, ≥ 2 ms, ≥ 3 ms... up to 4 ms.
+  EXPECT_EQ(due, (std::vector<TimeNs>{secondsToNs(1.2e-3), secondsToNs(2.0e-3), secondsToNs(3.2e-3),
+                                      secondsToNs(4.0e-3)}));
+}
+
+TEST(GyroPredictor, IntegratesConstantRateAndPredictsRotatedProjection) {
+  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+  // Camera looking along body +x: R_B_C maps C's z to B's x.
+  Mat3 R_B_C;
+  R_B_C << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  const Pose T_B_C(R_B_C, Vec3(0.1, 0.0, 0.05));
+  GyroPredictor pred(cam, T_B_C);
+  const Vec3 omega_B(0.3, -0.2, 0.5);
+  for (int k = 0; k <= 100; ++k) pred.addImu(ImuSample{secondsToNs(0.005 * k), Vec3::Zero(), omega_B});
+  const TimeNs t0 = secondsToNs(0.1), t1 = secondsToNs(0.3);
+  const Mat3 R = pred.rotation(t0, t1);
+  EXPECT_LT((R - so3::exp(omega_B * 0.2)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((pred.rotation(t1, t0) - R.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+  // A point at infinity seen at uv0 at t0 is seen at t1 along R_C1_C0 f0.
+  const Vec2 uv0(60.0, 130.0);
+  Vec3 f0;
+  ASSERT_TRUE(cam.unproject(uv0, &f0));
+  const Mat3 R_C0_C1 = R_B_C.transpose() * so3::exp(omega_B * 0.2) * R_B_C;
+  Vec2 expected;
+  ASSERT_TRUE(cam.project(R_C0_C1.transpose() * f0, &expected));
+  const auto uv1 = pred.predict(uv0, t0, t1);
+  ASSERT_TRUE(uv1.has_value());
+  EXPECT_LT((*uv1 - expected).norm(), 1e-9);
+  EXPECT_GT((*uv1 - uv0).norm(), 10.0);  // it did move
+}
+
+}  // namespace
+}  // namespace evio::estimator

@@ -1,0 +1,132 @@
+#include "evio/estimator/frontend/synchronizer.h"
+
+#include <gtest/gtest.h>
+
+#include "evio/core/error.h"
+
+namespace evio::estimator {
+namespace {
+
+TrackPoint point(FeatureId id, double t_s, Vec2 uv, TrackStatus status = TrackStatus::kTracked) {
+  return TrackPoint{id, secondsToNs(t_s), uv, 1.0, status};
+}
+
+/// A track moving linearly: uv(t) = uv0 + v t.
+Vec2 linear(const Vec2& uv0, const Vec2& v, double t) { return uv0 + v * t; }
+
+TEST(Synchronizer, EveryNeEventsExtrapolatesLinearlyToTheLatestTrackTime) {
+  SynchronizerOptions o;
+  o.n_e = 100;
+  Synchronizer sync(o);
+  const Vec2 a0(10, 20), va(5, -3), b0(50, 60), vb(-2, 7);
+  sync.addTrackPoints({point(1, 0.00, linear(a0, va, 0.00), TrackStatus::kNew), point(2, 0.01, linear(b0, vb, 0.01), TrackStatus::kNew),
+                       point(1, 0.02, linear(a0, va, 0.02)), point(2, 0.05, linear(b0, vb, 0.05)),
+                       point(1, 0.04, linear(a0, va, 0.04))});
+  sync.addEvents(99, secondsToNs(0.05));
+  MeasurementSet set;
+  EXPECT_FALSE(sync.poll(&set));  // 99 < n_e
+  sync.addEvents(1, secondsToNs(0.05));
+  ASSERT_TRUE(sync.poll(&set));
+  EXPECT_EQ(set.t_ns, secondsToNs(0.05));  // the latest track time
+  ASSERT_EQ(set.features.size(), 2u);
+  EXPECT_EQ(set.features[0].id, 1);
+  EXPECT_LT((set.features[0].uv - linear(a0, va, 0.05)).norm(), 1e-9);  // extrapolated from 0.02, 0.04
+  EXPECT_LT((set.features[1].uv - linear(b0, vb, 0.05)).norm(), 1e-9);
+  EXPECT_FALSE(set.features[0].has_previous);
+
+  // No track moved: n_e more events give no update.
+  sync.addEvents(100, secondsToNs(0.06));
+  EXPECT_FALSE(sync.poll(&set));
+
+  // Track 1 moves; the update time 0.07 > 0.05; previous = sent positions.
+  sync.addTrackPoints({point(1, 0.07, linear(a0, va, 0.07))});
+  sync.addEvents(100, secondsToNs(0.07));
+  ASSERT_TRUE(sync.poll(&set));
+  EXPECT_EQ(set.t_ns, secondsToNs(0.07));
+  EXPECT_TRUE(set.features[0].has_previous);
+  EXPECT_LT((set.features[0].uv_previous - linear(a0, va, 0.05)).norm(), 1e-9);
+  EXPECT_LT((set.features[0].uv - linear(a0, va, 0.07)).norm(), 1e-9);
+  EXPECT_LT((set.features[1].uv - linear(b0, vb, 0.07)).norm(), 1e-9);
+  EXPECT_LT((set.features[1].uv_previous - linear(b0, vb, 0.05)).norm(), 1e-9);
+}
+
+TEST(Synchronizer, UpdateTimeMustBeStrictlyAfterThePreviousAndLostTracksLeave) {
+  SynchronizerOptions o;
+  o.n_e = 10;
+  Synchronizer sync(o);
+  sync.addTrackPoints({point(1, 0.10, Vec2(1, 1), TrackStatus::kNew), point(2, 0.10, Vec2(5, 5), TrackStatus::kNew)});
+  sync.addEvents(10, secondsToNs(0.1));
+  MeasurementSet set;
+  ASSERT_TRUE(sync.poll(&set));
+  // A point at an older time for a track marks it moved but the latest time
+  // stays 0.10: no update.
+  sync.addTrackPoints({point(2, 0.10, Vec2(5.5, 5))});
+  sync.addEvents(10, secondsToNs(0.1));
+  EXPECT_FALSE(sync.poll(&set));
+  sync.addTrackPoints({point(2, 0.12, Vec2(6, 5)), point(1, 0.12, Vec2(1, 1), TrackStatus::kLost)});
+  sync.addEvents(10, secondsToNs(0.12));
+  ASSERT_TRUE(sync.poll(&set));
+  ASSERT_EQ(set.features.size(), 1u);
+  EXPECT_EQ(set.features[0].id, 2);
+  EXPECT_EQ(sync.numLiveTracks(), 1u);
+}
+
+TEST(Synchronizer, FixedRateAndMinimumRate) {
+  SynchronizerOptions o;
+  o.trigger = "fixed_rate";
+  o.rate_hz = 100.0;
+  Synchronizer fixed(o);
+  fixed.addTrackPoints({point(1, 0.0, Vec2(0, 0), TrackStatus::kNew), point(1, 0.01, Vec2(1, 0))});
+  fixed.advanceTime(secondsToNs(0.0));
+  fixed.advanceTime(secondsToNs(0.035));
+  MeasurementSet set;
+  std::vector<TimeNs> times;
+  while (fixed.poll(&set)) {
+    times.push_back(set.t_ns);
+    // Extrapolated at 100 px/s, capped at max_extrapolation_s (0.1 s) past 0.01.
+    EXPECT_NEAR(set.features[0].uv.x(), 100.0 * nsToSeconds(set.t_ns), 1e-9);
+  }
+  EXPECT_EQ(times, (std::vector<TimeNs>{secondsToNs(0.01), secondsToNs(0.02), secondsToNs(0.03)}));
+
+  SynchronizerOptions m;
+  m.n_e = 1000000;
+  m.min_rate_hz = 10.0;
+  Synchronizer minimum(m);
+  minimum.addTrackPoints({point(7, 1.0, Vec2(3, 4), TrackStatus::kNew)});
+  minimum.advanceTime(secondsToNs(1.0));
+  minimum.advanceTime(secondsToNs(1.05));
+  EXPECT_FALSE(minimum.poll(&set));
+  minimum.advanceTime(secondsToNs(1.1));
+  ASSERT_TRUE(minimum.poll(&set));  // no events at all, yet an update at 10 Hz
+  EXPECT_EQ(set.t_ns, secondsToNs(1.1));
+  EXPECT_EQ(set.features[0].uv, Vec2(3, 4));  // one point: held
+}
+
+TEST(Synchronizer, TrackTimeTriggerGivesOneUpdatePerFrame) {
+  SynchronizerOptions o;
+  o.trigger = "track_time";
+  Synchronizer sync(o);
+  MeasurementSet set;
+  for (int f = 0; f < 3; ++f) {
+    TrackPoints pts;
+    for (FeatureId id = 0; id < 4; ++id)
+      pts.push_back(point(id, 0.05 * f, Vec2(id, f), f == 0 ? TrackStatus::kNew : TrackStatus::kTracked));
+    sync.addTrackPoints(pts);
+    ASSERT_TRUE(sync.poll(&set));
+    EXPECT_EQ(set.t_ns, secondsToNs(0.05 * f));
+    EXPECT_EQ(set.features.size(), 4u);
+    EXPECT_FALSE(sync.poll(&set));
+  }
+}
+
+TEST(Synchronizer, RejectsBadOptions) {
+  SynchronizerOptions o;
+  o.trigger = "sometimes";
+  EXPECT_THROW(Synchronizer{o}, Error);
+  o = SynchronizerOptions{};
+  o.n_e = 0;
+  EXPECT_THROW(Synchronizer{o}, Error);
+}
+
+}  // namespace
+}  // namespace evio::estimator

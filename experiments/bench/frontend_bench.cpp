@@ -6,7 +6,7 @@
 //
 // The scene is a synthetic analogue of the Event-Camera Dataset's
 // poster_6dof at the DAVIS240 resolution (240×180): a dense analytic texture
-// of Gaussian blobs (tests/estimator/support/synthetic_events.h) moving
+// of Gaussian blobs (tests/support/synthetic_events.h) moving
 // rigidly (translation 60 px/s plus rotation 0.6 rad/s about the image
 // centre), events from log-intensity thresholding with C = 0.2, frames at
 // 20 Hz. It is generated once (a few seconds) before the first benchmark.
@@ -31,7 +31,7 @@
 #include "evio/core/camera/camera.h"
 #include "evio/estimator/frontend/eklt_tracker.h"
 #include "evio/estimator/frontend/event_prefilter.h"
-#include "support/synthetic_events.h"
+#include "synthetic_events.h"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include "evio/core/error.h"
 #include "evio/estimator/frontend/log_image.h"
 #include "numeric_jacobian.h"
-#include "support/synthetic_events.h"
+#include "synthetic_events.h"
 
 namespace evio::estimator {
 namespace {

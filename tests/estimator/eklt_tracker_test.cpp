@@ -7,7 +7,7 @@
 
 #include "evio/core/camera/pinhole_camera.h"
 #include "evio/estimator/frontend/feature_detection.h"
-#include "support/synthetic_events.h"
+#include "synthetic_events.h"
 
 namespace evio::estimator {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <map>
 
-#include "support/synthetic_events.h"
+#include "synthetic_events.h"
 
 namespace evio::estimator {
 namespace {

@@ -78,9 +78,13 @@ void ImageReconstructor::addFrame(TimeNs t_ns, const cv::Mat& image) {
         state_[k] = frame_log_[k] + (state_[k] - frame_log_[k]) * static_cast<float>(std::exp(-alpha * dt));
         last_t_ns_[k] = t_ns;
       }
-      if (row[c] > options_.saturation_low && row[c] < options_.saturation_high) frame_log_[k] = table[row[c]];
+      if (row[c] > options_.saturation_low && row[c] < options_.saturation_high) {
+        frame_log_[k] = table[row[c]];
+        if (!any_frame_) state_[k] = frame_log_[k];  // start from the first frame
+      }
     }
   }
+  any_frame_ = true;
 }
 
 cv::Mat ImageReconstructor::image(TimeNs t_ns) {

@@ -12,7 +12,9 @@
 /// (L_F = 0) this is the high-pass filter of the same paper: static scene
 /// content fades with time constant 1/α and edges that moved recently stay.
 /// A frame pixel is fused only when it is not saturated; saturated pixels keep
-/// the previous L_F, so events carry the dynamic range the frame lost.
+/// the previous L_F, so events carry the dynamic range the frame lost. The
+/// first fused frame also sets L̂ (where unsaturated), so the output does not
+/// start from a uniform grey that fades in at rate α.
 /// Frames are emitted as CV_32FC1 log images (to feed EkltTracker directly)
 /// at a configurable rate.
 
@@ -84,6 +86,7 @@ class ImageReconstructor {
   std::uint64_t events_since_output_ = 0;
   TimeNs next_output_t_ns_ = -1;
   bool due_ = false;
+  bool any_frame_ = false;
   TimeNs due_t_ns_ = 0;
 };
 

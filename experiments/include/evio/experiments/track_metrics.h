@@ -1,0 +1,85 @@
+#pragma once
+/// @file track_metrics.h
+/// Scores estimated feature tracks against ground-truth tracks (both in the
+/// tracks.txt format, core/io/tracks_txt.h), as in the feature-tracking
+/// evaluation of EKLT (Gehrig et al., IJCV 2019):
+///  - tracking error (px) against feature age (time since the track began),
+///  - feature age until the track is lost or its error first exceeds
+///    max_error_px (5 px),
+///  - the number of tracks alive over time.
+/// Each estimated track is associated with one ground-truth track: by equal
+/// id (match "id", for ground truth generated from the estimated tracks'
+/// first points) or by the ground-truth track nearest to the estimated
+/// track's first point at its first time, within association_radius_px
+/// (match "nearest"). Ground truth is interpolated linearly in time between
+/// its samples; gaps longer than max_gap_s (occlusion) are not bridged, and
+/// an estimated track is scored only while the ground truth covers it.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "evio/core/io/tracks_txt.h"
+#include "evio/core/options.h"
+
+namespace evio::experiments {
+
+struct TrackMetricsOptions {
+  std::string match = "nearest";        ///< nearest | id
+  double association_radius_px = 2.0;   ///< nearest: largest start distance
+  double max_error_px = 5.0;            ///< a track's scored life ends above this error
+  double max_gap_s = 0.1;               ///< ground-truth samples further apart are not interpolated
+  double age_bin_s = 0.05;              ///< bin width of error vs age
+  double alive_bin_s = 0.05;            ///< sampling interval of the alive count
+
+  template <class V>
+  void fields(V& v) {
+    v("match", match, "nearest or id");
+    v("association_radius_px", association_radius_px, "nearest: largest start distance, px");
+    v("max_error_px", max_error_px, "error that ends a track's scored life, px");
+    v("max_gap_s", max_gap_s, "longest ground-truth gap that is interpolated, s");
+    v("age_bin_s", age_bin_s, "bin width of error vs age, s");
+    v("alive_bin_s", alive_bin_s, "sampling interval of the alive count, s");
+  }
+  void validate() const;
+};
+
+struct AgeBin {
+  double age_s = 0.0;         ///< start of the bin
+  double mean_error_px = 0.0;
+  std::uint64_t samples = 0;
+};
+
+struct AliveSample {
+  double t_s = 0.0;
+  std::uint64_t estimated = 0;  ///< estimated tracks alive (first ≤ t ≤ last sample)
+  std::uint64_t truth = 0;      ///< ground-truth tracks visible
+};
+
+struct TrackMetrics {
+  std::uint64_t estimated_tracks = 0;
+  std::uint64_t matched_tracks = 0;
+  std::uint64_t scored_samples = 0;
+  double mean_error_px = 0.0;          ///< over scored samples (before the error passes the limit)
+  double median_error_px = 0.0;
+  double mean_feature_age_s = 0.0;     ///< over matched tracks
+  double median_feature_age_s = 0.0;
+  double mean_track_length_s = 0.0;    ///< over all estimated tracks, last − first sample
+  std::vector<AgeBin> error_vs_age;
+  std::vector<AliveSample> alive;
+};
+
+/// Scores `estimated` against `truth`. Throws evio::Error for bad options.
+TrackMetrics evaluateTracks(const std::vector<io::TrackSample>& estimated, const std::vector<io::TrackSample>& truth,
+                            const TrackMetricsOptions& options);
+
+/// The summary and both tables as one JSON object.
+std::string trackMetricsJson(const TrackMetrics& metrics);
+
+/// Error vs age as CSV: "age_s,mean_error_px,samples".
+std::string errorVsAgeCsv(const TrackMetrics& metrics);
+
+/// Alive count as CSV: "t_s,estimated,truth".
+std::string aliveCsv(const TrackMetrics& metrics);
+
+}  // namespace evio::experiments

@@ -1,0 +1,172 @@
+#include "evio/experiments/track_sequence.h"
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+
+#include "evio/core/error.h"
+#include "evio/core/io/calib_txt.h"
+#include "evio/core/io/events_h5.h"
+#include "evio/core/io/events_txt.h"
+#include "evio/core/io/images_txt.h"
+#include "evio/core/io/imu_txt.h"
+#include "evio/core/io/sensors_yaml.h"
+
+namespace evio::experiments {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Events in time order from events.h5 or events.txt, handed out up to a time.
+class EventSource {
+ public:
+  explicit EventSource(const std::string& folder) {
+    const fs::path h5 = fs::path(folder) / "events.h5";
+    const fs::path txt = fs::path(folder) / "events.txt";
+    if (fs::exists(h5)) {
+      h5_ = std::make_unique<io::EventH5Reader>(h5.string());
+      total_ = h5_->size();
+    } else if (fs::exists(txt)) {
+      txt_ = std::make_unique<io::EventTextReader>(txt.string());
+      total_ = static_cast<std::uint64_t>(fs::file_size(txt) / 24);  // ~bytes per line, for progress only
+    } else {
+      throw Error(folder + ": no events.h5 or events.txt");
+    }
+  }
+
+  /// Replaces `out` with the next events with t < t_end_ns (all when
+  /// t_end_ns is nullopt), at most about `max` at a time; false when none.
+  bool next(EventArray& out, std::optional<TimeNs> t_end_ns, std::size_t max = 1u << 16) {
+    out.clear();
+    if (pos_ >= buffer_.size()) {
+      buffer_.clear();
+      pos_ = 0;
+      const bool more = h5_ ? h5_->next(buffer_, max) : txt_->next(buffer_, max);
+      if (!more) return false;
+      read_ += buffer_.size();
+    }
+    std::size_t end = buffer_.size();
+    if (t_end_ns) end = std::max(pos_, std::min(end, buffer_.lowerBound(*t_end_ns)));
+    if (end == pos_) return false;
+    out.reserve(end - pos_);
+    for (std::size_t i = pos_; i < end; ++i) out.push_back(buffer_.t()[i], buffer_.x()[i], buffer_.y()[i], buffer_.p()[i] != 0);
+    pos_ = end;
+    return true;
+  }
+
+  std::uint64_t read() const { return read_; }
+  double fraction() const { return total_ > 0 ? std::min(1.0, static_cast<double>(read_) / static_cast<double>(total_)) : 0.0; }
+
+ private:
+  std::unique_ptr<io::EventH5Reader> h5_;
+  std::unique_ptr<io::EventTextReader> txt_;
+  EventArray buffer_;
+  std::size_t pos_ = 0;
+  std::uint64_t read_ = 0;
+  std::uint64_t total_ = 0;
+};
+
+struct CameraChoice {
+  Camera camera;
+  std::optional<Pose> T_B_C;
+  std::string name;
+};
+
+CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
+                          const std::vector<io::ImageStamp>& images) {
+  const fs::path sensors = fs::path(folder) / "sensors.yaml";
+  if (fs::exists(sensors)) {
+    const SensorRig rig = io::readSensorsYaml(sensors.string());
+    const CameraSensor* pick = nullptr;
+    for (const auto& c : rig.cameras)
+      if (c.role == (frame_camera ? CameraRole::kFrame : CameraRole::kEvent)) {
+        pick = &c;
+        break;
+      }
+    if (pick == nullptr) pick = &rig.cameras.front();
+    return CameraChoice{pick->camera, pick->T_B_C, pick->name};
+  }
+  const fs::path calib = fs::path(folder) / "calib.txt";
+  if (!fs::exists(calib)) throw Error(folder + ": neither sensors.yaml nor calib.txt");
+  if (images.empty()) throw Error(folder + ": calib.txt gives no resolution and there are no frames");
+  const cv::Mat first = io::readFrame(folder, images.front());
+  return CameraChoice{io::cameraFromCalibTxt(io::readCalibTxt(calib.string()), first.cols, first.rows), std::nullopt,
+                      "calib.txt"};
+}
+
+}  // namespace
+
+TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& options,
+                                  const TrackProgress& progress) {
+  options.validate();
+  if (!fs::is_directory(folder)) throw Error(folder + ": not a folder");
+  const bool has_images = fs::exists(fs::path(folder) / "images.txt");
+  const std::vector<io::ImageStamp> images = has_images ? io::readImageList(folder) : std::vector<io::ImageStamp>{};
+  if (images.empty() && options.image_source == "frames")
+    throw Error(folder + ": no frames (images.txt); use image_source reconstructed");
+  const CameraChoice cam = chooseCamera(folder, options.tracker == "klt", images);
+  ImuSamples imu;
+  if (options.tracker == "eklt" && options.eklt.imu_prediction) {
+    imu = io::readImuText((fs::path(folder) / "imu.txt").string());
+    if (!cam.T_B_C) throw Error(folder + ": imu_prediction needs T_B_C from sensors.yaml");
+  }
+
+  estimator::Frontend frontend(options, cam.camera, cam.T_B_C);
+  EventSource events(folder);
+  TrackSequenceResult result;
+  result.camera_name = cam.name;
+  std::unordered_map<std::int64_t, TimeNs> last_t;
+  estimator::TrackPoints points;
+  std::size_t next_imu = 0;
+  double busy = 0.0;
+  const auto collect = [&] {
+    points.clear();
+    frontend.drainTrackPoints(points);
+    for (const auto& p : points) {
+      if (p.status == estimator::TrackStatus::kLost) continue;
+      auto [it, inserted] = last_t.try_emplace(p.feature_id, p.t_ns);
+      if (!inserted) {
+        if (p.t_ns <= it->second) continue;  // a track's times must increase in tracks.txt
+        it->second = p.t_ns;
+      }
+      result.samples.push_back(io::TrackSample{p.feature_id, p.t_ns, p.uv});
+    }
+  };
+  const auto feedImuUntil = [&](TimeNs t) {
+    while (next_imu < imu.size() && imu[next_imu].t_ns <= t) frontend.addImu(imu[next_imu++]);
+  };
+  const auto run = [&](auto&& fn) {
+    const auto start = std::chrono::steady_clock::now();
+    fn();
+    busy += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  EventArray chunk;
+  const auto feedEventsUntil = [&](std::optional<TimeNs> t_end) {
+    while (events.next(chunk, t_end)) {
+      feedImuUntil(chunk.t().back());
+      run([&] { frontend.addEvents(chunk); });
+      collect();
+      if (progress) progress(events.fraction(), events.read());
+    }
+  };
+  for (const auto& stamp : images) {
+    feedEventsUntil(stamp.t_ns);
+    const cv::Mat frame = io::readFrame(folder, stamp, cv::Size(cam.camera.width(), cam.camera.height()));
+    feedImuUntil(stamp.t_ns);
+    run([&] { frontend.addFrame(stamp.t_ns, frame); });
+    collect();
+    ++result.frames;
+  }
+  feedEventsUntil(std::nullopt);
+  result.events = frontend.numEventsSeen();
+  result.events_kept = frontend.numEventsKept();
+  result.reconstructed_frames = frontend.numReconstructedFrames();
+  result.tracks = last_t.size();
+  result.processing_s = busy;
+  return result;
+}
+
+}  // namespace evio::experiments

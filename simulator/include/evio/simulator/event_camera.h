@@ -1,0 +1,224 @@
+#pragma once
+/// @file event_camera.h
+/// The event camera: a per-pixel state machine over radiance samples
+/// (ESIM, Rebecq et al. CoRL 2018; noise after v2e, Hu, Liu & Delbruck,
+/// CVPRW 2021), with every event labelled signal or noise.
+///
+/// Per pixel i, for a sample (t, I) with I the radiance in W/(m²·sr):
+///
+///  1. Log radiance  L_in = log(ε + max(I, 0))     (NaN radiance counts as 0).
+///  2. Photoreceptor low-pass (when cutoff_max_hz > 0): first order,
+///       τ dL_f/dt = L_in(t) − L_f,   τ = 1 / (2π f_c(I)),
+///       f_c(I) = f_min + (f_max − f_min) · I / (I + I_ref),
+///     solved exactly for L_in linear between the two samples and f_c held at
+///     the newer sample's value over the interval (x = Δt/τ):
+///       L_f(t1) = L_in(t1) + (L_f(t0) − L_in(t0)) e^(−x) − ΔL_in (1 − e^(−x)) / x.
+///     In the dark f_c → f_min, so events lag and thin out (v2e scales the
+///     cut-off linearly with intensity; this form is linear for I ≪ I_ref and
+///     saturates at f_max in bright light). Without it L_f = L_in.
+///  3. Events: the pixel stores a reference r. While L_f(t1) ≥ r + C⁺_k:
+///     r += C⁺_k and an ON event is timed where the straight line from
+///     (t0, L_f(t0)) to (t1, L_f(t1)) crosses r (rounded to ns, kept in
+///     (t0, t1]); OFF alike with r −= C⁻_k. So after every sample
+///     r − C⁻ < L_f < r + C⁺, and Σ polarity·threshold = r − r_0.
+///  4. Thresholds: C^±_i = max(C_min, C^± + σ_m z^±_i), z fixed per pixel
+///     (stream "event_threshold_mismatch"); with jitter σ_j > 0 the threshold
+///     of crossing k is max(C_min, C^±_i + σ_j z^±_{i,k}) ("event_jitter").
+///  5. Refractory period: a crossing less than refractory_period_s after the
+///     pixel's last emitted signal event moves r but emits nothing.
+///  6. Noise, independent of the pixel's reference (noise events neither move
+///     r nor start a refractory period), each with its own label:
+///     - leak: ON events, Poisson at leak_rate_hz per pixel ("event_leak");
+///     - shot: ON or OFF with equal probability, Poisson per pixel at
+///         r_shot(I) = R_shot (1 − (1 − b) · I / (I + I_ref)),
+///       R_shot in the dark, b·R_shot in bright light (v2e's linear
+///       intensity dependence, its b = 0.25), the rate held at the newer
+///       sample's value over each interval ("event_shot_noise");
+///     - hot pixels: round(fraction · N) pixels chosen once emit ON events,
+///       Poisson at hot_pixel_rate_hz each ("event_hot_pixels").
+///
+/// Determinism: every per-pixel draw is counterHash(stream key, pixel,
+/// counter) (counter_rng.h), so it does not depend on the order pixels are
+/// processed in or on the thread count. Leak and hot-pixel events depend on
+/// time alone: the superposition of N Poisson processes of rate r is one of
+/// rate N·r with a uniformly drawn pixel, drawn from a sequential stream.
+/// Memory is flat: 48 bytes of state per pixel plus the events pending.
+///
+/// How to drive it from a render loop:
+///  - Whole frames: `update(t, radiance, &events, &labels)` once per render
+///    (the first call only sets the references and emits nothing). Every
+///    event up to t is emitted, time-sorted, appended to `events`.
+///  - Adaptive, per pixel: after one whole-frame `update` (or `initialize`),
+///    feed the pixels of each render with `updatePixel(i, t, I)` (each pixel's
+///    times strictly increasing), then call `emit(&events, &labels)` once per
+///    render: it appends, time-sorted, every event at or before the watermark
+///    = the earliest last-sample time over all pixels, and keeps the rest
+///    pending. Events after the watermark can still be preceded by events of
+///    pixels not yet sampled that far, so they wait. To end a sequence at
+///    t_end, sample every pixel at t_end (e.g. one `update`) and `emit`.
+///  Output order: by time, then pixel (y·width + x), then label, then polarity;
+///  a total order, so the stream does not depend on the thread count.
+
+#include <cstdint>
+#include <opencv2/core/mat.hpp>
+#include <vector>
+
+#include "evio/core/event.h"
+#include "evio/core/options.h"
+#include "evio/core/random_stream.h"
+#include "evio/core/time.h"
+
+namespace evio::simulator {
+
+/// Why an event exists (truth/ labels).
+enum class EventLabel : std::uint8_t {
+  kSignal = 0,  ///< a contrast-threshold crossing of the (filtered) log radiance
+  kLeak = 1,    ///< leak (background activity) noise
+  kShot = 2,    ///< shot noise, rising in the dark
+  kHot = 3,     ///< a hot pixel
+};
+
+/// "signal", "leak", "shot", "hot".
+const char* eventLabelName(EventLabel label);
+
+class EventCamera {
+ public:
+  struct Options {
+    double threshold_pos = 0.2;             ///< C⁺, nominal ON threshold, log units
+    double threshold_neg = 0.2;             ///< C⁻, nominal OFF threshold, log units
+    double threshold_mismatch_sigma = 0.03; ///< σ_m of the fixed per-pixel threshold offset, log units
+    double threshold_jitter_sigma = 0.0;    ///< σ_j of the per-crossing threshold noise, log units
+    double threshold_min = 0.01;            ///< C_min, lower clamp of every threshold, log units
+    double refractory_period_s = 0.0;       ///< dead time after an emitted signal event, s
+    double log_eps_w_m2_sr = 1e-3;          ///< ε of L = log(ε + I), W/(m²·sr)
+    double cutoff_max_hz = 0.0;             ///< photoreceptor cut-off in bright light, Hz; 0 = ideal (no filter)
+    double cutoff_min_hz = 1.0;             ///< cut-off floor in the dark, Hz
+    double reference_radiance_w_m2_sr = 1.0;///< I_ref: where bandwidth and shot noise are half-way to bright
+    double leak_rate_hz = 0.0;              ///< leak events per pixel per second
+    double shot_noise_rate_hz = 0.0;        ///< R_shot: shot-noise events per pixel per second in the dark
+    double shot_noise_bright_factor = 0.25; ///< b: rate in bright light as a fraction of R_shot
+    double hot_pixel_fraction = 0.0;        ///< fraction of pixels that are hot
+    double hot_pixel_rate_hz = 100.0;       ///< events per second of each hot pixel
+    int threads = 1;                        ///< threads of update(), 0 = all cores (output does not depend on it)
+
+    template <class V>
+    void fields(V& v) {
+      v("threshold_pos", threshold_pos, "ON contrast threshold, log units");
+      v("threshold_neg", threshold_neg, "OFF contrast threshold, log units");
+      v("threshold_mismatch_sigma", threshold_mismatch_sigma, "per-pixel threshold sigma, log units");
+      v("threshold_jitter_sigma", threshold_jitter_sigma, "per-crossing threshold sigma, log units");
+      v("threshold_min", threshold_min, "lower clamp of thresholds, log units");
+      v("refractory_period_s", refractory_period_s, "refractory period, s");
+      v("log_eps_w_m2_sr", log_eps_w_m2_sr, "epsilon of log(eps + I), W/(m^2 sr)");
+      v("cutoff_max_hz", cutoff_max_hz, "photoreceptor cut-off in bright light, Hz (0 = ideal)");
+      v("cutoff_min_hz", cutoff_min_hz, "photoreceptor cut-off floor in the dark, Hz");
+      v("reference_radiance_w_m2_sr", reference_radiance_w_m2_sr, "half-way radiance I_ref, W/(m^2 sr)");
+      v("leak_rate_hz", leak_rate_hz, "leak events per pixel per second");
+      v("shot_noise_rate_hz", shot_noise_rate_hz, "shot noise per pixel per second in the dark");
+      v("shot_noise_bright_factor", shot_noise_bright_factor, "bright/dark shot noise rate ratio");
+      v("hot_pixel_fraction", hot_pixel_fraction, "fraction of hot pixels");
+      v("hot_pixel_rate_hz", hot_pixel_rate_hz, "events per second of a hot pixel");
+      v("threads", threads, "threads, 0 = all cores");
+    }
+    void validate() const;
+  };
+
+  /// A camera of width × height pixels (pixel index i = y·width + x).
+  EventCamera(int width, int height, const Options& options, std::uint64_t seed);
+
+  /// Sets every pixel from a first image at t_ns (CV_32FC1 W/(m²·sr), or a
+  /// row-major array of width·height floats): r = L_f = L_in, no events.
+  void initialize(TimeNs t_ns, const float* radiance);
+  void initialize(TimeNs t_ns, const cv::Mat& radiance);
+  bool initialized() const { return initialized_; }
+
+  /// A sample of every pixel at t_ns (after every pixel's last sample; the
+  /// first call initialises). Appends all events up to t_ns, time-sorted, to
+  /// `events` and their labels to `labels` (may be null).
+  void update(TimeNs t_ns, const float* radiance, EventArray* events, std::vector<EventLabel>* labels);
+  void update(TimeNs t_ns, const cv::Mat& radiance, EventArray* events, std::vector<EventLabel>* labels);
+
+  /// A sample of pixel `index` at t_ns (> that pixel's last sample; throws
+  /// otherwise). Its events wait in the pending buffer until emit().
+  void updatePixel(std::size_t index, TimeNs t_ns, float radiance);
+
+  /// Appends, time-sorted, the pending events at or before the watermark
+  /// (min over pixels of the last sample time) plus the leak and hot-pixel
+  /// noise up to it; returns the watermark. O(pixels + pending events).
+  TimeNs emit(EventArray* events, std::vector<EventLabel>* labels);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  std::size_t pixelCount() const { return n_; }
+  const Options& options() const { return options_; }
+
+  /// Time of the last sample of pixel i.
+  TimeNs lastSampleTime(std::size_t i) const { return uniform_ ? uniform_t_ : t_prev_[i]; }
+  /// Reference level r of pixel i (log units).
+  float reference(std::size_t i) const { return ref_[i]; }
+  /// Filtered log radiance L_f at the last sample of pixel i.
+  float filteredLog(std::size_t i) const { return lf_prev_[i]; }
+  /// The pixel's fixed thresholds C^±_i (before per-crossing jitter).
+  float thresholdPos(std::size_t i) const;
+  float thresholdNeg(std::size_t i) const;
+  /// Whether pixel i is hot.
+  bool isHot(std::size_t i) const;
+  /// Events waiting in the pending buffer.
+  std::size_t pendingCount() const { return pending_.size(); }
+  /// Total pixel samples processed (whole-frame pixels plus updatePixel calls).
+  std::uint64_t pixelUpdates() const { return pixel_updates_; }
+
+  /// One event before it is emitted (pixel index, not x/y).
+  struct Pending {
+    TimeNs t_ns;
+    std::uint32_t pixel;
+    std::uint8_t positive;
+    EventLabel label;
+  };
+
+ private:
+  void processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, const float* radiance,
+                    std::vector<Pending>* out);
+  void crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float l1, std::vector<Pending>* out);
+  void shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, float rate_hz,
+                 std::vector<Pending>* out);
+  void generateTimedNoise(TimeNs up_to);
+  void appendSorted(TimeNs watermark, EventArray* events, std::vector<EventLabel>* labels);
+
+  int width_ = 0, height_ = 0;
+  std::size_t n_ = 0;
+  Options options_;
+  std::uint64_t key_mismatch_ = 0, key_jitter_ = 0, key_shot_ = 0;
+  bool initialized_ = false;
+  bool bandwidth_ = false, shot_ = false, jitter_ = false;
+  TimeNs refractory_ns_ = 0;
+  TimeNs t_init_ = 0;
+
+  // Per-pixel state (structure of arrays).
+  std::vector<TimeNs> t_prev_;          ///< last sample time
+  std::vector<TimeNs> t_last_event_;    ///< last emitted signal event (refractory)
+  std::vector<float> lin_prev_;         ///< L_in at the last sample
+  std::vector<float> lf_prev_;          ///< L_f at the last sample
+  std::vector<float> ref_;              ///< reference r
+  std::vector<float> th_pos_, th_neg_;  ///< thresholds of the next crossing
+  std::vector<float> shot_budget_;      ///< remaining Exp(1) hazard to the next shot event
+  std::vector<std::uint32_t> crossing_count_, shot_count_;
+
+  // While every pixel was last sampled by update()/initialize() at the same
+  // time, t_prev_ is not written: uniform_t_ holds that time.
+  bool uniform_ = true;
+  TimeNs uniform_t_ = 0;
+  TimeNs t_max_sample_ = 0;             ///< latest sample time of any pixel
+
+  // Leak and hot pixels: time-only Poisson processes.
+  RandomStream leak_rng_, hot_rng_;
+  double next_leak_ns_ = 0.0, next_hot_ns_ = 0.0;
+  std::vector<std::uint32_t> hot_pixels_;   ///< sorted indices of hot pixels
+  TimeNs noise_done_ns_ = 0;                ///< timed noise generated up to here
+
+  std::vector<Pending> pending_;
+  std::vector<std::vector<Pending>> block_events_;
+  std::uint64_t pixel_updates_ = 0;
+};
+
+}  // namespace evio::simulator

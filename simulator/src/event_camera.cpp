@@ -1,0 +1,437 @@
+#include "evio/simulator/event_camera.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "evio/core/error.h"
+#include "evio/simulator/counter_rng.h"
+#include "evio/simulator/fast_math.h"
+
+namespace evio::simulator {
+
+namespace {
+
+constexpr std::size_t kChunk = 256;      // pixels per vectorised chunk
+constexpr std::size_t kBlock = 16384;    // pixels per parallel block
+constexpr float kTwoPi = 2.0f * std::numbers::pi_v<float>;
+
+bool pendingLess(const EventCamera::Pending& a, const EventCamera::Pending& b) {
+  if (a.t_ns != b.t_ns) return a.t_ns < b.t_ns;
+  if (a.pixel != b.pixel) return a.pixel < b.pixel;
+  if (a.label != b.label) return a.label < b.label;
+  return a.positive < b.positive;
+}
+
+/// (1 − e^(−x)) / x for x ≥ 0, given e = e^(−x); its series below 10⁻³.
+inline float phiOf(float x, float e) {
+  return x < 1e-3f ? 1.0f - x * (0.5f - x * (1.0f / 6.0f)) : (1.0f - e) / x;
+}
+
+/// Constants of the per-pixel arithmetic, shared by the block and the
+/// per-pixel paths so that both give bit-identical results.
+struct PixelMath {
+  float eps, fmin, fspan, iref, rshot, bshot;
+
+  explicit PixelMath(const EventCamera::Options& o)
+      : eps(static_cast<float>(o.log_eps_w_m2_sr)),
+        fmin(static_cast<float>(o.cutoff_min_hz)),
+        fspan(static_cast<float>(o.cutoff_max_hz - o.cutoff_min_hz)),
+        iref(static_cast<float>(o.reference_radiance_w_m2_sr)),
+        rshot(static_cast<float>(o.shot_noise_rate_hz)),
+        bshot(1.0f - static_cast<float>(o.shot_noise_bright_factor)) {}
+
+  /// max(I, 0), NaN → 0.
+  static float clampRadiance(float v) { return v > 0.0f ? v : 0.0f; }
+  float logOf(float v) const { return fastLog(eps + v); }
+  /// L_f at the new sample (exact first-order step, piecewise-linear input).
+  float filtered(float v, float dt_s, float lin, float lin0, float lf0) const {
+    const float x = kTwoPi * (fmin + fspan * (v / (v + iref))) * dt_s;
+    const float e = fastExpNonPositive(-x);
+    return lin + (lf0 - lin0) * e - (lin - lin0) * phiOf(x, e);
+  }
+  float shotRate(float v) const { return rshot * (1.0f - bshot * (v / (v + iref))); }
+};
+
+}  // namespace
+
+const char* eventLabelName(EventLabel label) {
+  switch (label) {
+    case EventLabel::kSignal: return "signal";
+    case EventLabel::kLeak: return "leak";
+    case EventLabel::kShot: return "shot";
+    case EventLabel::kHot: return "hot";
+  }
+  return "unknown";
+}
+
+void EventCamera::Options::validate() const {
+  requirePositive("threshold_pos", threshold_pos);
+  requirePositive("threshold_neg", threshold_neg);
+  requireNonNegative("threshold_mismatch_sigma", threshold_mismatch_sigma);
+  requireNonNegative("threshold_jitter_sigma", threshold_jitter_sigma);
+  requirePositive("threshold_min", threshold_min);
+  requireNonNegative("refractory_period_s", refractory_period_s);
+  requirePositive("log_eps_w_m2_sr", log_eps_w_m2_sr);
+  requireNonNegative("cutoff_max_hz", cutoff_max_hz);
+  requirePositive("cutoff_min_hz", cutoff_min_hz);
+  requireField(cutoff_max_hz == 0.0 || cutoff_min_hz <= cutoff_max_hz, "cutoff_min_hz",
+               "must be <= cutoff_max_hz");
+  requirePositive("reference_radiance_w_m2_sr", reference_radiance_w_m2_sr);
+  requireNonNegative("leak_rate_hz", leak_rate_hz);
+  requireNonNegative("shot_noise_rate_hz", shot_noise_rate_hz);
+  requireInRange("shot_noise_bright_factor", shot_noise_bright_factor, 0.0, 1e3);
+  requireInRange("hot_pixel_fraction", hot_pixel_fraction, 0.0, 1.0);
+  requireNonNegative("hot_pixel_rate_hz", hot_pixel_rate_hz);
+  requireInRange("threads", threads, 0, 1024);
+}
+
+EventCamera::EventCamera(int width, int height, const Options& options, std::uint64_t seed)
+    : width_(width),
+      height_(height),
+      options_(options),
+      leak_rng_(seed, "event_leak"),
+      hot_rng_(seed, "event_hot_pixels") {
+  options_.validate();
+  requireField(width > 0 && height > 0 && width <= 65536 && height <= 65536, "width/height",
+               "must be in [1, 65536]");
+  n_ = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  key_mismatch_ = counterKey(seed, "event_threshold_mismatch");
+  key_jitter_ = counterKey(seed, "event_jitter");
+  key_shot_ = counterKey(seed, "event_shot_noise");
+  bandwidth_ = options_.cutoff_max_hz > 0.0;
+  shot_ = options_.shot_noise_rate_hz > 0.0;
+  jitter_ = options_.threshold_jitter_sigma > 0.0;
+  refractory_ns_ = secondsToNs(options_.refractory_period_s);
+
+  t_prev_.assign(n_, 0);
+  t_last_event_.assign(n_, std::numeric_limits<TimeNs>::min() / 2);
+  lin_prev_.assign(n_, 0.0f);
+  lf_prev_.assign(n_, 0.0f);
+  ref_.assign(n_, 0.0f);
+  th_pos_.resize(n_);
+  th_neg_.resize(n_);
+  shot_budget_.resize(n_);
+  crossing_count_.assign(n_, 0);
+  shot_count_.assign(n_, 0);
+  const float c_min = static_cast<float>(options_.threshold_min);
+  for (std::size_t i = 0; i < n_; ++i) {
+    th_pos_[i] = thresholdPos(i);
+    th_neg_[i] = thresholdNeg(i);
+    if (jitter_) {
+      const double s = options_.threshold_jitter_sigma;
+      th_pos_[i] = std::max(c_min, th_pos_[i] + static_cast<float>(s * counterNormal(key_jitter_, i, 0)));
+      th_neg_[i] = std::max(c_min, th_neg_[i] + static_cast<float>(s * counterNormal(key_jitter_, i, 1)));
+    }
+    shot_budget_[i] = static_cast<float>(counterExponential(key_shot_, i, 0));
+  }
+
+  // Hot pixels: a partial Fisher–Yates shuffle draws round(fraction · N) distinct pixels.
+  const auto hot_count = static_cast<std::size_t>(std::llround(options_.hot_pixel_fraction * static_cast<double>(n_)));
+  if (hot_count > 0) {
+    std::vector<std::uint32_t> index(n_);
+    for (std::size_t i = 0; i < n_; ++i) index[i] = static_cast<std::uint32_t>(i);
+    for (std::size_t k = 0; k < hot_count; ++k) {
+      const std::size_t j = k + static_cast<std::size_t>(hot_rng_.uniformInt(n_ - k));
+      std::swap(index[k], index[j]);
+    }
+    hot_pixels_.assign(index.begin(), index.begin() + static_cast<std::ptrdiff_t>(hot_count));
+    std::sort(hot_pixels_.begin(), hot_pixels_.end());
+  }
+}
+
+float EventCamera::thresholdPos(std::size_t i) const {
+  const double c = options_.threshold_pos + options_.threshold_mismatch_sigma * counterNormal(key_mismatch_, i, 0);
+  return static_cast<float>(std::max(options_.threshold_min, c));
+}
+
+float EventCamera::thresholdNeg(std::size_t i) const {
+  const double c = options_.threshold_neg + options_.threshold_mismatch_sigma * counterNormal(key_mismatch_, i, 1);
+  return static_cast<float>(std::max(options_.threshold_min, c));
+}
+
+bool EventCamera::isHot(std::size_t i) const {
+  return std::binary_search(hot_pixels_.begin(), hot_pixels_.end(), static_cast<std::uint32_t>(i));
+}
+
+void EventCamera::initialize(TimeNs t_ns, const cv::Mat& radiance) {
+  require(radiance.type() == CV_32FC1 && radiance.rows == height_ && radiance.cols == width_ &&
+              radiance.isContinuous(),
+          "EventCamera: radiance must be a continuous CV_32FC1 image of " + std::to_string(width_) + "x" +
+              std::to_string(height_));
+  initialize(t_ns, radiance.ptr<float>());
+}
+
+void EventCamera::initialize(TimeNs t_ns, const float* radiance) {
+  require(!initialized_, "EventCamera::initialize: already initialised");
+  const PixelMath pm(options_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    const float l = pm.logOf(PixelMath::clampRadiance(radiance[i]));
+    lin_prev_[i] = l;
+    lf_prev_[i] = l;
+    ref_[i] = l;
+  }
+  uniform_ = true;
+  uniform_t_ = t_ns;
+  t_max_sample_ = t_ns;
+  t_init_ = t_ns;
+  noise_done_ns_ = t_ns;
+  const double n = static_cast<double>(n_);
+  if (options_.leak_rate_hz > 0.0)
+    next_leak_ns_ = static_cast<double>(t_ns) + 1e9 * leak_rng_.exponential(options_.leak_rate_hz * n);
+  if (!hot_pixels_.empty() && options_.hot_pixel_rate_hz > 0.0)
+    next_hot_ns_ = static_cast<double>(t_ns) +
+                   1e9 * hot_rng_.exponential(options_.hot_pixel_rate_hz * static_cast<double>(hot_pixels_.size()));
+  pixel_updates_ += n_;
+  initialized_ = true;
+}
+
+void EventCamera::update(TimeNs t_ns, const cv::Mat& radiance, EventArray* events,
+                         std::vector<EventLabel>* labels) {
+  require(radiance.type() == CV_32FC1 && radiance.rows == height_ && radiance.cols == width_ &&
+              radiance.isContinuous(),
+          "EventCamera: radiance must be a continuous CV_32FC1 image of " + std::to_string(width_) + "x" +
+              std::to_string(height_));
+  update(t_ns, radiance.ptr<float>(), events, labels);
+}
+
+void EventCamera::update(TimeNs t_ns, const float* radiance, EventArray* events,
+                         std::vector<EventLabel>* labels) {
+  if (!initialized_) {
+    initialize(t_ns, radiance);
+    return;
+  }
+  require(t_ns > t_max_sample_, "EventCamera::update: time " + std::to_string(t_ns) +
+                                    " ns is not after the last sample " + std::to_string(t_max_sample_) + " ns");
+  const std::size_t blocks = (n_ + kBlock - 1) / kBlock;
+  block_events_.resize(blocks);
+  const auto run = [&](std::size_t b) {
+    block_events_[b].clear();
+    processBlock(b * kBlock, std::min(n_, (b + 1) * kBlock), t_ns, radiance, &block_events_[b]);
+  };
+  if (options_.threads == 1 || blocks == 1) {
+    for (std::size_t b = 0; b < blocks; ++b) run(b);
+  } else {
+    tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t b = r.begin(); b != r.end(); ++b) run(b);
+                        });
+    });
+  }
+  for (const auto& block : block_events_) pending_.insert(pending_.end(), block.begin(), block.end());
+  uniform_ = true;
+  uniform_t_ = t_ns;
+  t_max_sample_ = t_ns;
+  pixel_updates_ += n_;
+  generateTimedNoise(t_ns);
+  appendSorted(t_ns, events, labels);
+}
+
+void EventCamera::processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, const float* radiance,
+                               std::vector<Pending>* out) {
+  const PixelMath pm(options_);
+  float lin[kChunk], lf[kChunk], dt[kChunk], hazard[kChunk], rate[kChunk], v[kChunk];
+  const bool uniform = uniform_;
+  const float dt_uniform = static_cast<float>(t_ns - uniform_t_) * 1e-9f;
+  for (std::size_t c = begin; c < end; c += kChunk) {
+    const std::size_t m = std::min(kChunk, end - c);
+    const float* in = radiance + c;
+    for (std::size_t j = 0; j < m; ++j) {
+      v[j] = PixelMath::clampRadiance(in[j]);
+      lin[j] = pm.logOf(v[j]);
+    }
+    if (uniform) {
+      for (std::size_t j = 0; j < m; ++j) dt[j] = dt_uniform;
+    } else {
+      for (std::size_t j = 0; j < m; ++j) dt[j] = static_cast<float>(t_ns - t_prev_[c + j]) * 1e-9f;
+    }
+    if (bandwidth_) {
+      const float* lin0 = lin_prev_.data() + c;
+      const float* lf0 = lf_prev_.data() + c;
+      for (std::size_t j = 0; j < m; ++j) lf[j] = pm.filtered(v[j], dt[j], lin[j], lin0[j], lf0[j]);
+    } else {
+      for (std::size_t j = 0; j < m; ++j) lf[j] = lin[j];
+    }
+    if (shot_) {
+      for (std::size_t j = 0; j < m; ++j) {
+        rate[j] = pm.shotRate(v[j]);
+        hazard[j] = rate[j] * dt[j];
+      }
+    }
+    float* ref = ref_.data() + c;
+    const float* thp = th_pos_.data() + c;
+    const float* thn = th_neg_.data() + c;
+    const float* lf0 = lf_prev_.data() + c;
+    for (std::size_t j = 0; j < m; ++j) {
+      if (lf[j] - ref[j] >= thp[j] || ref[j] - lf[j] >= thn[j]) {
+        const TimeNs t0 = uniform ? uniform_t_ : t_prev_[c + j];
+        crossings(c + j, t0, t_ns, lf0[j], lf[j], out);
+      }
+    }
+    if (shot_) {
+      float* budget = shot_budget_.data() + c;
+      for (std::size_t j = 0; j < m; ++j) {
+        if (hazard[j] >= budget[j]) {
+          const TimeNs t0 = uniform ? uniform_t_ : t_prev_[c + j];
+          shotNoise(c + j, t0, t_ns, hazard[j], rate[j], out);
+        } else {
+          budget[j] -= hazard[j];
+        }
+      }
+    }
+    std::copy(lf, lf + m, lf_prev_.data() + c);
+    if (bandwidth_) std::copy(lin, lin + m, lin_prev_.data() + c);
+  }
+}
+
+void EventCamera::crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float l1, std::vector<Pending>* out) {
+  float r = ref_[i];
+  float thp = th_pos_[i], thn = th_neg_[i];
+  const double dl = static_cast<double>(l1) - static_cast<double>(l0);
+  const double span = static_cast<double>(t1 - t0);
+  const float c_min = static_cast<float>(options_.threshold_min);
+  float base_pos = 0.0f, base_neg = 0.0f;
+  if (jitter_) {
+    base_pos = thresholdPos(i);
+    base_neg = thresholdNeg(i);
+  }
+  const auto cross = [&](bool positive) {
+    double frac = dl != 0.0 ? (static_cast<double>(r) - static_cast<double>(l0)) / dl : 1.0;
+    frac = std::clamp(frac, 0.0, 1.0);
+    const TimeNs t = std::clamp<TimeNs>(t0 + std::llround(frac * span), t0 + 1, t1);
+    if (t - t_last_event_[i] >= refractory_ns_) {
+      out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
+                             EventLabel::kSignal});
+      t_last_event_[i] = t;
+    }
+    const std::uint32_t k = ++crossing_count_[i];
+    if (jitter_) {
+      const double s = options_.threshold_jitter_sigma;
+      thp = std::max(c_min, base_pos + static_cast<float>(s * counterNormal(key_jitter_, i, 2ull * k)));
+      thn = std::max(c_min, base_neg + static_cast<float>(s * counterNormal(key_jitter_, i, 2ull * k + 1)));
+    }
+  };
+  if (l1 - r >= thp) {
+    while (l1 - r >= thp) {
+      r += thp;
+      cross(true);
+    }
+  } else {
+    while (r - l1 >= thn) {
+      r -= thn;
+      cross(false);
+    }
+  }
+  ref_[i] = r;
+  th_pos_[i] = thp;
+  th_neg_[i] = thn;
+}
+
+void EventCamera::shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, float rate_hz,
+                            std::vector<Pending>* out) {
+  // Cumulative hazard rate·(t − t0) reaches the pending Exp(1) budget at each event.
+  double acc = static_cast<double>(shot_budget_[i]);
+  const double h = static_cast<double>(hazard);
+  std::uint32_t k = shot_count_[i];
+  while (acc <= h) {
+    const TimeNs t = std::clamp<TimeNs>(t0 + std::llround(acc / static_cast<double>(rate_hz) * 1e9), t0 + 1, t1);
+    const bool positive = counterUniform(key_shot_, i, 2ull * k + 1) < 0.5;
+    out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
+                           EventLabel::kShot});
+    ++k;
+    acc += counterExponential(key_shot_, i, 2ull * k);
+  }
+  shot_count_[i] = k;
+  shot_budget_[i] = static_cast<float>(acc - h);
+}
+
+void EventCamera::updatePixel(std::size_t i, TimeNs t_ns, float radiance) {
+  require(initialized_, "EventCamera::updatePixel: call initialize() or update() first");
+  require(i < n_, "EventCamera::updatePixel: pixel index " + std::to_string(i) + " out of range");
+  if (uniform_) {
+    std::fill(t_prev_.begin(), t_prev_.end(), uniform_t_);
+    uniform_ = false;
+  }
+  const TimeNs t0 = t_prev_[i];
+  require(t_ns > t0, "EventCamera::updatePixel: time " + std::to_string(t_ns) + " ns of pixel " +
+                         std::to_string(i) + " is not after its last sample " + std::to_string(t0) + " ns");
+  const PixelMath pm(options_);
+  const float v = PixelMath::clampRadiance(radiance);
+  const float lin = pm.logOf(v);
+  const float dt = static_cast<float>(t_ns - t0) * 1e-9f;
+  float lf = lin;
+  if (bandwidth_) {
+    lf = pm.filtered(v, dt, lin, lin_prev_[i], lf_prev_[i]);
+    lin_prev_[i] = lin;
+  }
+  if (lf - ref_[i] >= th_pos_[i] || ref_[i] - lf >= th_neg_[i]) crossings(i, t0, t_ns, lf_prev_[i], lf, &pending_);
+  if (shot_) {
+    const float rate = pm.shotRate(v);
+    const float hazard = rate * dt;
+    if (hazard >= shot_budget_[i]) {
+      shotNoise(i, t0, t_ns, hazard, rate, &pending_);
+    } else {
+      shot_budget_[i] -= hazard;
+    }
+  }
+  lf_prev_[i] = lf;
+  t_prev_[i] = t_ns;
+  t_max_sample_ = std::max(t_max_sample_, t_ns);
+  ++pixel_updates_;
+}
+
+TimeNs EventCamera::emit(EventArray* events, std::vector<EventLabel>* labels) {
+  require(initialized_, "EventCamera::emit: call initialize() or update() first");
+  const TimeNs watermark = uniform_ ? uniform_t_ : *std::min_element(t_prev_.begin(), t_prev_.end());
+  generateTimedNoise(watermark);
+  appendSorted(watermark, events, labels);
+  return watermark;
+}
+
+void EventCamera::generateTimedNoise(TimeNs up_to) {
+  if (up_to <= noise_done_ns_) return;
+  const double limit = static_cast<double>(up_to) + 1.0;  // floor(t) <= up_to
+  if (options_.leak_rate_hz > 0.0) {
+    const double rate = options_.leak_rate_hz * static_cast<double>(n_);
+    while (next_leak_ns_ < limit) {
+      const auto pixel = static_cast<std::uint32_t>(leak_rng_.uniformInt(n_));
+      pending_.push_back(Pending{static_cast<TimeNs>(next_leak_ns_), pixel, 1, EventLabel::kLeak});
+      next_leak_ns_ += 1e9 * leak_rng_.exponential(rate);
+    }
+  }
+  if (!hot_pixels_.empty() && options_.hot_pixel_rate_hz > 0.0) {
+    const double rate = options_.hot_pixel_rate_hz * static_cast<double>(hot_pixels_.size());
+    while (next_hot_ns_ < limit) {
+      const std::uint32_t pixel = hot_pixels_[hot_rng_.uniformInt(hot_pixels_.size())];
+      pending_.push_back(Pending{static_cast<TimeNs>(next_hot_ns_), pixel, 1, EventLabel::kHot});
+      next_hot_ns_ += 1e9 * hot_rng_.exponential(rate);
+    }
+  }
+  noise_done_ns_ = up_to;
+}
+
+void EventCamera::appendSorted(TimeNs watermark, EventArray* events, std::vector<EventLabel>* labels) {
+  const auto ready_end = std::partition(pending_.begin(), pending_.end(),
+                                        [watermark](const Pending& p) { return p.t_ns <= watermark; });
+  std::sort(pending_.begin(), ready_end, pendingLess);
+  if (events != nullptr) {
+    const auto w = static_cast<std::uint32_t>(width_);
+    for (auto it = pending_.begin(); it != ready_end; ++it)
+      events->push_back(it->t_ns, static_cast<std::uint16_t>(it->pixel % w), static_cast<std::uint16_t>(it->pixel / w),
+                        it->positive != 0);
+  }
+  if (labels != nullptr) {
+    for (auto it = pending_.begin(); it != ready_end; ++it) labels->push_back(it->label);
+  }
+  pending_.erase(pending_.begin(), ready_end);
+}
+
+}  // namespace evio::simulator

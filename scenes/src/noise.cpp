@@ -64,6 +64,18 @@ inline float grad3(std::uint32_t h, float x, float y, float z) {
   }
 }
 
+/// Lattice hash for gradient3: one avalanche per corner over per-axis
+/// products (cheaper than hash(); used where speed matters, per pixel).
+inline std::uint32_t corner(std::uint32_t hx, std::uint32_t hy, std::uint32_t hz) {
+  std::uint32_t h = hx ^ hy ^ hz;
+  h ^= h >> 15U;
+  h *= 0x2c1b3c6dU;
+  h ^= h >> 12U;
+  h *= 0x297a2d39U;
+  h ^= h >> 15U;
+  return h;
+}
+
 }  // namespace
 
 std::uint32_t hash(std::int32_t x, std::int32_t y, std::int32_t z, std::uint32_t seed) {
@@ -93,21 +105,26 @@ float gradient3(const Eigen::Vector3f& p, std::uint32_t seed) {
   const float fy = p.y() - static_cast<float>(iy);
   const float fz = p.z() - static_cast<float>(iz);
   const float u = fadef(fx), v = fadef(fy), w = fadef(fz);
-  const float n000 = grad3(hash(ix, iy, iz, seed), fx, fy, fz);
-  const float n100 = grad3(hash(ix + 1, iy, iz, seed), fx - 1.0f, fy, fz);
-  const float n010 = grad3(hash(ix, iy + 1, iz, seed), fx, fy - 1.0f, fz);
-  const float n110 = grad3(hash(ix + 1, iy + 1, iz, seed), fx - 1.0f, fy - 1.0f, fz);
-  const float n001 = grad3(hash(ix, iy, iz + 1, seed), fx, fy, fz - 1.0f);
-  const float n101 = grad3(hash(ix + 1, iy, iz + 1, seed), fx - 1.0f, fy, fz - 1.0f);
-  const float n011 = grad3(hash(ix, iy + 1, iz + 1, seed), fx, fy - 1.0f, fz - 1.0f);
-  const float n111 = grad3(hash(ix + 1, iy + 1, iz + 1, seed), fx - 1.0f, fy - 1.0f, fz - 1.0f);
+  constexpr std::uint32_t kX = 0x8da6b343U, kY = 0xd8163841U, kZ = 0xcb1ab31fU;
+  const std::uint32_t x0 = (static_cast<std::uint32_t>(ix) * kX) ^ seed;
+  const std::uint32_t x1 = (static_cast<std::uint32_t>(ix + 1) * kX) ^ seed;
+  const std::uint32_t y0 = static_cast<std::uint32_t>(iy) * kY, y1 = static_cast<std::uint32_t>(iy + 1) * kY;
+  const std::uint32_t z0 = static_cast<std::uint32_t>(iz) * kZ, z1 = static_cast<std::uint32_t>(iz + 1) * kZ;
+  const float n000 = grad3(corner(x0, y0, z0), fx, fy, fz);
+  const float n100 = grad3(corner(x1, y0, z0), fx - 1.0f, fy, fz);
+  const float n010 = grad3(corner(x0, y1, z0), fx, fy - 1.0f, fz);
+  const float n110 = grad3(corner(x1, y1, z0), fx - 1.0f, fy - 1.0f, fz);
+  const float n001 = grad3(corner(x0, y0, z1), fx, fy, fz - 1.0f);
+  const float n101 = grad3(corner(x1, y0, z1), fx - 1.0f, fy, fz - 1.0f);
+  const float n011 = grad3(corner(x0, y1, z1), fx, fy - 1.0f, fz - 1.0f);
+  const float n111 = grad3(corner(x1, y1, z1), fx - 1.0f, fy - 1.0f, fz - 1.0f);
   const float x00 = n000 + u * (n100 - n000);
   const float x10 = n010 + u * (n110 - n010);
   const float x01 = n001 + u * (n101 - n001);
   const float x11 = n011 + u * (n111 - n011);
-  const float y0 = x00 + v * (x10 - x00);
-  const float y1 = x01 + v * (x11 - x01);
-  return y0 + w * (y1 - y0);
+  const float y00 = x00 + v * (x10 - x00);
+  const float y11 = x01 + v * (x11 - x01);
+  return y00 + w * (y11 - y00);
 }
 
 double fbm2(double x, double y, int octaves, double gain, std::uint32_t seed, double lacunarity) {
@@ -124,20 +141,23 @@ double fbm2(double x, double y, int octaves, double gain, std::uint32_t seed, do
 }
 
 float fbm3(const Eigen::Vector3f& p, int octaves, float gain, std::uint32_t seed, float footprint) {
-  float sum = 0.0f, norm = 0.0f, amp = 1.0f, freq = 1.0f;
-  for (int o = 0; o < octaves; ++o) norm += std::pow(gain, static_cast<float>(o));
+  float norm = 0.0f;
+  {
+    float a = 1.0f;
+    for (int o = 0; o < octaves; ++o, a *= gain) norm += a;
+  }
+  float sum = 0.0f, amp = 1.0f, freq = 1.0f;
   for (int o = 0; o < octaves; ++o) {
     float weight = 1.0f;
     if (footprint > 0.0f) {
-      // wavelength 1/freq; fade out between 4 and 2 footprints.
+      // wavelength 1/freq in footprints; fade out between 8 and 4.
       const float ratio = 1.0f / (freq * footprint);
-      if (ratio <= 2.0f) break;
-      if (ratio < 4.0f) weight = (ratio - 2.0f) * 0.5f;
+      if (ratio <= 4.0f) break;
+      if (ratio < 8.0f) weight = (ratio - 4.0f) * 0.25f;
     }
     const float off = 17.31f * static_cast<float>(o);
     sum += weight * amp *
-           gradient3(p * freq + Eigen::Vector3f(off, -off, 0.5f * off),
-                     seed + static_cast<std::uint32_t>(o));
+           gradient3(p * freq + Eigen::Vector3f(off, -off, 0.5f * off), seed + static_cast<std::uint32_t>(o));
     amp *= gain;
     freq *= 2.0f;
   }

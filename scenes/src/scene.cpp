@@ -169,6 +169,14 @@ void Scene::generate(const SceneBuildOptions& /*options*/) {
       sm.mesh.uvs.resize(sm.mesh.positions.size());
       for (std::size_t k = 0; k < sm.mesh.positions.size(); ++k) sm.mesh.uvs[k] = sm.mesh.positions[k].head<2>();
     }
+    sm.face_normals.reserve(sm.mesh.triangles.size());
+    for (const auto& t : sm.mesh.triangles) {
+      const Eigen::Vector3f& p0 = sm.mesh.positions[static_cast<std::size_t>(t[0])];
+      const Eigen::Vector3f n = (sm.mesh.positions[static_cast<std::size_t>(t[1])] - p0)
+                                    .cross(sm.mesh.positions[static_cast<std::size_t>(t[2])] - p0);
+      const float len = n.norm();
+      sm.face_normals.push_back(len > 0.0f ? Eigen::Vector3f(n / len) : Eigen::Vector3f::Zero());
+    }
     stats_.triangles += sm.mesh.triangles.size();
     stats_.vertices += sm.mesh.positions.size();
     meshes_.push_back(std::move(sm));
@@ -217,24 +225,26 @@ void Scene::buildEmbree(const SceneBuildOptions& options) {
   if (e != RTC_ERROR_NONE) throw Error("Embree: building the scene failed (error " + std::to_string(e) + ")");
 }
 
-SurfaceHit Scene::surfaceHit(unsigned geom, unsigned prim, float u, float v, const Eigen::Vector3f& dir) const {
-  const TriangleMesh& m = meshes_[geom].mesh;
+void Scene::surfaceHit(unsigned geom, unsigned prim, float u, float v, const Eigen::Vector3f& dir,
+                       SurfaceHit* hit) const {
+  const SceneMesh& sm = meshes_[geom];
+  const TriangleMesh& m = sm.mesh;
   const Eigen::Vector3i& t = m.triangles[prim];
   const auto i0 = static_cast<std::size_t>(t[0]), i1 = static_cast<std::size_t>(t[1]),
              i2 = static_cast<std::size_t>(t[2]);
   const float w0 = 1.0f - u - v;
-  SurfaceHit h;
+  SurfaceHit& h = *hit;
   h.mesh = geom;
   h.prim = prim;
   h.b1 = u;
   h.b2 = v;
-  h.p = w0 * m.positions[i0] + u * m.positions[i1] + v * m.positions[i2];
-  Eigen::Vector3f ng = (m.positions[i1] - m.positions[i0]).cross(m.positions[i2] - m.positions[i0]);
-  const float len = ng.norm();
-  ng = len > 0.0f ? Eigen::Vector3f(ng / len) : Eigen::Vector3f(-dir);
+  const Eigen::Vector3f& p0 = m.positions[i0];
+  h.p = w0 * p0 + u * m.positions[i1] + v * m.positions[i2];
+  Eigen::Vector3f ng = sm.face_normals[prim];
+  if (ng.x() == 0.0f && ng.y() == 0.0f && ng.z() == 0.0f) ng = -dir;  // degenerate triangle
   Eigen::Vector3f n = w0 * m.normals[i0] + u * m.normals[i1] + v * m.normals[i2];
-  const float nlen = n.norm();
-  n = nlen > 0.0f ? Eigen::Vector3f(n / nlen) : ng;
+  const float nlen2 = n.squaredNorm();
+  n = nlen2 > 0.0f ? Eigen::Vector3f(n * (1.0f / std::sqrt(nlen2))) : ng;
   h.back_face = ng.dot(dir) > 0.0f;
   if (h.back_face) {
     ng = -ng;
@@ -244,7 +254,6 @@ SurfaceHit Scene::surfaceHit(unsigned geom, unsigned prim, float u, float v, con
   h.n = n;
   h.ng = ng;
   h.uv = w0 * m.uvs[i0] + u * m.uvs[i1] + v * m.uvs[i2];
-  return h;
 }
 
 float Scene::albedo(const SurfaceHit& hit, float footprint_m) const {
@@ -285,6 +294,7 @@ bool Scene::shadowRay(int k, const SurfaceHit& hit, ShadowRay* ray) const {
   const float eps = 5e-5f * (1.0f + hit.p.cwiseAbs().maxCoeff());
   ray->origin = hit.p + eps * hit.ng;
   ray->direction = wi;
+  ray->e_normal = e;
   const DirectLight& d = direct_[static_cast<std::size_t>(k)];
   ray->t_far = d.kind == 0 ? std::numeric_limits<float>::infinity()
                            : (d.vec - ray->origin).norm() * (1.0f - 1e-5f);
@@ -292,18 +302,16 @@ bool Scene::shadowRay(int k, const SurfaceHit& hit, ShadowRay* ray) const {
 }
 
 float Scene::radiance(const SurfaceHit& hit, const Eigen::Vector3f& to_viewer, float albedo,
-                      const unsigned char* visible) const {
+                      const LightSample* lights) const {
   const Reflectance& refl = materials_[static_cast<std::size_t>(meshes_[hit.mesh].material)].reflectance;
   const float c_o = hit.n.dot(to_viewer);
   float l = 0.0f;
   for (int k = 0; k < static_cast<int>(direct_.size()); ++k) {
-    if (!visible[k]) continue;
-    Eigen::Vector3f wi;
-    float e = 0.0f;
-    lightFrom(hit, k, &wi, &e);
-    const float c_i = hit.n.dot(wi);
+    const LightSample& s = lights[k];
+    if (!(s.e_normal > 0.0f)) continue;
+    const float c_i = hit.n.dot(s.wi);
     if (c_i <= 0.0f) continue;
-    l += refl.brdfOverAlbedo(wi, to_viewer, c_i, c_o) * e * c_i;
+    l += refl.brdfOverAlbedo(s.wi, to_viewer, c_i, c_o) * s.e_normal * c_i;
   }
   float e_amb;
   if (indirect_on_) e_amb = interpolate(hit, indirect_);

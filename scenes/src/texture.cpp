@@ -66,6 +66,16 @@ Texture::Texture(const TextureOptions& options, std::uint64_t seed, const std::s
   else if (t == "collage") kind_ = Kind::kCollage;
   else throw Error(field + ".type: unknown texture type '" + t + "' (known: " + TextureOptions::knownTypes() + ")");
 
+  if (kind_ == Kind::kNoise || kind_ == Kind::kCollage)
+    lattice_ = std::make_unique<noise::ValueLattice>(seed);
+  if (kind_ == Kind::kNoise) {
+    noise_.inv_patch_wl = static_cast<float>(1.0 / options.patch_wavelength_m);
+    noise_.inv_detail_wl = static_cast<float>(1.0 / options.detail_wavelength_m);
+    noise_.threshold = static_cast<float>(0.5 * (0.5 - options.rock_fraction));
+    noise_.dust = static_cast<float>(options.dust_albedo);
+    noise_.rock_minus_dust = static_cast<float>(options.rock_albedo - options.dust_albedo);
+    noise_.contrast = static_cast<float>(1.6 * options.detail_contrast);
+  }
   if (kind_ == Kind::kImage) {
     std::filesystem::path p(options.path);
     if (p.is_relative() && !base_dir.empty()) p = std::filesystem::path(base_dir) / p;
@@ -81,6 +91,7 @@ Texture::Texture(const TextureOptions& options, std::uint64_t seed, const std::s
           throw Error(field + ".path: " + p.string() + ": non-finite pixel at (" + std::to_string(c) +
                       ", " + std::to_string(r) + ")");
   }
+  if (kind_ == Kind::kImage) mip_ = MipMap(image_, options.repeat);
   if (kind_ == Kind::kShapes || kind_ == Kind::kCollage) {
     RandomStream rng(seed, "texture shapes");
     const double rmin = options.shape_size_m.x(), rmax = options.shape_size_m.y();
@@ -101,45 +112,50 @@ Texture::Texture(const TextureOptions& options, std::uint64_t seed, const std::s
                     : static_cast<float>(rng.uniform(options.foreground, options.background));
       shapes_.push_back(s);
     }
+    // Bake onto texels of 1/8 of the smallest radius (at most 4096 per axis).
+    const double texel = std::max({options.shape_size_m.x() / 8.0, options.region_m.x() / 4096.0,
+                                   options.region_m.y() / 4096.0});
+    texel_m_ = static_cast<float>(texel);
+    const int cols = std::max(1, static_cast<int>(std::ceil(options.region_m.x() / texel)));
+    const int rows = std::max(1, static_cast<int>(std::ceil(options.region_m.y() / texel)));
+    cv::Mat baked(rows, cols, CV_32FC1);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const Eigen::Vector2f uv(static_cast<float>((c + 0.5) * texel), static_cast<float>((r + 0.5) * texel));
+        baked.at<float>(r, c) = kind_ == Kind::kShapes
+                                    ? shapes(uv, texel_m_, static_cast<float>(options.background))
+                                    : collage(uv, texel_m_);
+      }
+    mip_ = MipMap(baked, false);
   }
 }
 
 float Texture::noise(const Eigen::Vector3f& p, float footprint) const {
-  const auto& o = options_;
+  const NoiseConstants& c = noise_;
   // Dust/rock patches: a low-frequency field thresholded softly at the rock fraction.
-  const float patch = noise::fbm3(p / static_cast<float>(o.patch_wavelength_m), 3, 0.5f, seed_);
-  const float threshold = 0.6f * (0.5f - static_cast<float>(o.rock_fraction));
-  const float rock = noise::smoothstep(threshold - 0.08f, threshold + 0.08f, patch);
-  const float base = static_cast<float>(o.dust_albedo) +
-                     rock * static_cast<float>(o.rock_albedo - o.dust_albedo);
-  const float wl = static_cast<float>(o.detail_wavelength_m);
-  const float detail = noise::fbm3(p / wl, o.octaves, 0.6f, seed_ + 101U, footprint / wl);
-  return clamp01(base * (1.0f + static_cast<float>(o.detail_contrast) * 1.6f * detail));
+  const float patch = lattice_->value(p * c.inv_patch_wl);
+  const float rock = noise::smoothstep(c.threshold - 0.08f, c.threshold + 0.08f, patch);
+  const float base = c.dust + rock * c.rock_minus_dust;
+  const float detail = lattice_->fbm(p * c.inv_detail_wl + Eigen::Vector3f(11.3f, 29.1f, 5.7f),
+                                     options_.octaves, 0.6f, footprint * c.inv_detail_wl);
+  return clamp01(base * (1.0f + c.contrast * detail));
 }
 
-float Texture::image(const Eigen::Vector2f& uv) const {
+float Texture::collage(const Eigen::Vector2f& uv, float footprint) const {
+  // Paper with a soft mottled print under the shapes.
+  const Eigen::Vector3f q(uv.x() * 12.0f, uv.y() * 12.0f, 0.37f);
+  const float n = lattice_->fbm(q, options_.octaves, 0.55f, footprint * 12.0f);
+  const float bg = clamp01(static_cast<float>(options_.background) * (1.0f + 0.35f * n));
+  return shapes(uv, footprint, bg);
+}
+
+float Texture::image(const Eigen::Vector2f& uv, float footprint) const {
   const auto& o = options_;
-  float s = (uv.x() - static_cast<float>(o.offset_m.x())) / static_cast<float>(o.size_m.x()) *
-                static_cast<float>(image_.cols) - 0.5f;
-  float t = (uv.y() - static_cast<float>(o.offset_m.y())) / static_cast<float>(o.size_m.y()) *
-                static_cast<float>(image_.rows) - 0.5f;
-  const int x0 = static_cast<int>(std::floor(s)), y0 = static_cast<int>(std::floor(t));
-  const float fx = s - static_cast<float>(x0), fy = t - static_cast<float>(y0);
-  const auto fetch = [&](int x, int y) {
-    if (o.repeat) {
-      x %= image_.cols;
-      y %= image_.rows;
-      if (x < 0) x += image_.cols;
-      if (y < 0) y += image_.rows;
-    } else {
-      x = std::clamp(x, 0, image_.cols - 1);
-      y = std::clamp(y, 0, image_.rows - 1);
-    }
-    return image_.at<float>(y, x);
-  };
-  const float a = fetch(x0, y0) + fx * (fetch(x0 + 1, y0) - fetch(x0, y0));
-  const float b = fetch(x0, y0 + 1) + fx * (fetch(x0 + 1, y0 + 1) - fetch(x0, y0 + 1));
-  return clamp01(static_cast<float>(o.gain) * (a + fy * (b - a)));
+  const float sx = static_cast<float>(image_.cols) / static_cast<float>(o.size_m.x());
+  const float sy = static_cast<float>(image_.rows) / static_cast<float>(o.size_m.y());
+  return clamp01(static_cast<float>(o.gain) *
+                 mip_.sample((uv.x() - static_cast<float>(o.offset_m.x())) * sx,
+                             (uv.y() - static_cast<float>(o.offset_m.y())) * sy, footprint * sx));
 }
 
 float Texture::shapes(const Eigen::Vector2f& uv, float footprint, float background) const {
@@ -179,14 +195,14 @@ float Texture::evaluate(const Eigen::Vector3f& p_W, const Eigen::Vector2f& uv_m,
       return static_cast<float>((i & 1LL) ? options_.value_b : options_.value);
     }
     case Kind::kNoise: return noise(p_W, footprint_m);
-    case Kind::kImage: return image(uv_m);
-    case Kind::kShapes: return shapes(uv_m, footprint_m, static_cast<float>(options_.background));
+    case Kind::kImage: return image(uv_m, footprint_m);
+    case Kind::kShapes:
     case Kind::kCollage: {
-      // Paper with a soft mottled print under the shapes.
-      const Eigen::Vector3f q(uv_m.x() * 12.0f, uv_m.y() * 12.0f, 0.37f);
-      const float n = noise::fbm3(q, options_.octaves, 0.55f, seed_ + 7U, footprint_m * 12.0f);
-      const float bg = clamp01(static_cast<float>(options_.background) * (1.0f + 0.35f * n));
-      return shapes(uv_m, footprint_m, bg);
+      const float s = uv_m.x() / texel_m_, t = uv_m.y() / texel_m_;
+      if (s < 0.0f || t < 0.0f || s > static_cast<float>(mip_.level(0).cols) ||
+          t > static_cast<float>(mip_.level(0).rows))
+        return static_cast<float>(options_.background);
+      return mip_.sample(s, t, footprint_m / texel_m_);
     }
   }
   return 0.0f;

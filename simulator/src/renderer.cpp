@@ -1,6 +1,7 @@
 #include "evio/simulator/renderer.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -43,7 +44,18 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
   pixel_angle_rad_ = static_cast<float>(1.0 / camera_.intrinsics()[0]);
 }
 
-RenderOutput Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity) const {
+/// Per-thread buffers of one tile, reused from tile to tile.
+struct Renderer::Scratch {
+  std::vector<RTCRayHit> rays;
+  std::vector<Eigen::Vector3f> dirs;
+  std::vector<scenes::SurfaceHit> hits;
+  std::vector<float> albedo;
+  std::vector<scenes::LightSample> light;
+  std::vector<RTCRay> shadow;
+  std::vector<std::uint32_t> shadow_slot;
+};
+
+RenderOutput Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderStats* stats) const {
   if (options_.check_viewpoint) scene_.checkViewpoint(T_W_C.translation());
   const int w = camera_.width(), h = camera_.height();
   RenderOutput out;
@@ -53,16 +65,28 @@ RenderOutput Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity)
   if (velocity) out.flow.create(h, w, CV_32FC2);
   const int t = options_.tile_px;
   const int tiles = ((w + t - 1) / t) * ((h + t - 1) / t);
+  std::vector<RenderStats> counts(static_cast<std::size_t>(tiles));
+  tbb::enumerable_thread_specific<Scratch> scratch;
   tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
-      for (int k = r.begin(); k != r.end(); ++k) renderTile(k, T_W_C, velocity, &out);
+      Scratch& s = scratch.local();
+      for (int k = r.begin(); k != r.end(); ++k)
+        renderTile(k, T_W_C, velocity, &out, &counts[static_cast<std::size_t>(k)], &s);
     });
   });
+  if (stats) {
+    *stats = RenderStats{};
+    for (const auto& c : counts) {
+      stats->camera_rays += c.camera_rays;
+      stats->shadow_rays += c.shadow_rays;
+    }
+  }
   return out;
 }
 
-void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out) const {
+void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
+                          RenderStats* counts, Scratch* scratch) const {
   const int w = camera_.width(), h = camera_.height(), t = options_.tile_px;
   const int tiles_x = (w + t - 1) / t;
   const int x0 = (tile % tiles_x) * t, y0 = (tile / tiles_x) * t;
@@ -72,101 +96,111 @@ void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* vel
   const bool super = n > 1;
   const int per_pixel = super ? 1 + nn : 1;  // centre ray (+ radiance rays)
   const int pixels = (x1 - x0) * (y1 - y0);
-  const int rays = pixels * per_pixel;
-  const int lights = scene_.shadowLightCount();
+  const auto rays = static_cast<std::size_t>(pixels * per_pixel);
+  const auto lights = static_cast<std::size_t>(scene_.shadowLightCount());
 
   const Eigen::Matrix3f R = T_W_C.rotation().cast<float>();
   const Eigen::Vector3f org = T_W_C.translation().cast<float>();
 
-  std::vector<RTCRayHit> rh(static_cast<std::size_t>(rays));
-  std::vector<Eigen::Vector3f> dirs(static_cast<std::size_t>(rays));
-  for (int y = y0, r = 0; y < y1; ++y)
+  Scratch& s = *scratch;
+  s.rays.resize(rays);
+  s.dirs.resize(rays);
+  s.hits.resize(rays);
+  s.albedo.resize(rays);
+  s.light.assign(rays * std::max<std::size_t>(lights, 1), scenes::LightSample{});
+  s.shadow.clear();
+  s.shadow_slot.clear();
+
+  std::size_t ri = 0;
+  for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      for (int s = 0; s < per_pixel; ++s, ++r) {
-        const Eigen::Vector3f& b = s == 0 ? bearings_[p] : sub_bearings_[p * static_cast<std::size_t>(nn) + static_cast<std::size_t>(s - 1)];
-        const auto ri = static_cast<std::size_t>(r);
+      for (int k = 0; k < per_pixel; ++k, ++ri) {
+        const Eigen::Vector3f& b =
+            k == 0 ? bearings_[p] : sub_bearings_[p * static_cast<std::size_t>(nn) + static_cast<std::size_t>(k - 1)];
         if (std::isnan(b.x())) {
-          dirs[ri] = Eigen::Vector3f::UnitZ();
-          scenes::setRayHit(rh[ri], org, dirs[ri], 1.0f, 0.0f);  // tnear > tfar: inactive
+          s.dirs[ri] = Eigen::Vector3f::UnitZ();
+          scenes::setRayHit(s.rays[ri], org, s.dirs[ri], 1.0f, 0.0f);  // tnear > tfar: inactive
           continue;
         }
-        dirs[ri] = R * b;
-        scenes::setRayHit(rh[ri], org, dirs[ri]);
+        s.dirs[ri] = R * b;
+        scenes::setRayHit(s.rays[ri], org, s.dirs[ri]);
+        ++counts->camera_rays;
       }
     }
   RTCIntersectContext coherent = scenes::intersectContext(true);
-  rtcIntersect1M(scene_.embree(), &coherent, rh.data(), static_cast<unsigned>(rays), sizeof(RTCRayHit));
+  rtcIntersect1M(scene_.embree(), &coherent, s.rays.data(), static_cast<unsigned>(rays), sizeof(RTCRayHit));
 
   // Shading inputs and occlusion rays.
-  std::vector<scenes::SurfaceHit> hits(static_cast<std::size_t>(rays));
-  std::vector<float> albedo(static_cast<std::size_t>(rays), 0.0f);
-  std::vector<unsigned char> visible(static_cast<std::size_t>(rays) * static_cast<std::size_t>(std::max(lights, 1)), 0);
-  std::vector<RTCRay> shadow;
-  std::vector<std::size_t> shadow_slot;
-  shadow.reserve(static_cast<std::size_t>(rays) * static_cast<std::size_t>(lights));
-  shadow_slot.reserve(shadow.capacity());
-  for (int r = 0; r < rays; ++r) {
-    const auto ri = static_cast<std::size_t>(r);
-    if (rh[ri].hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-    const bool shaded = !super || (r % per_pixel) != 0;
-    hits[ri] = scene_.surfaceHit(rh[ri].hit.geomID, rh[ri].hit.primID, rh[ri].hit.u, rh[ri].hit.v, dirs[ri]);
-    if (!shaded) continue;
-    const float cos_view = std::max(std::abs(hits[ri].n.dot(dirs[ri])), 0.2f);
-    const float footprint = rh[ri].ray.tfar * pixel_angle_rad_ / (cos_view * static_cast<float>(n));
-    albedo[ri] = scene_.albedo(hits[ri], footprint);
-    for (int k = 0; k < lights; ++k) {
-      scenes::ShadowRay s;
-      if (!scene_.shadowRay(k, hits[ri], &s)) continue;
-      RTCRay ray;
-      scenes::setRay(ray, s.origin, s.direction, 0.0f, s.t_far);
-      shadow.push_back(ray);
-      shadow_slot.push_back(ri * static_cast<std::size_t>(lights) + static_cast<std::size_t>(k));
+  const float footprint_scale = pixel_angle_rad_ / static_cast<float>(n);
+  for (ri = 0; ri < rays; ++ri) {
+    const RTCRayHit& q = s.rays[ri];
+    if (q.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+    scenes::SurfaceHit& hit = s.hits[ri];
+    scene_.surfaceHit(q.hit.geomID, q.hit.primID, q.hit.u, q.hit.v, s.dirs[ri], &hit);
+    if (super && ri % static_cast<std::size_t>(per_pixel) == 0) continue;  // geometry-only centre ray
+    const float cos_view = std::max(-hit.n.dot(s.dirs[ri]), 0.2f);
+    s.albedo[ri] = scene_.albedo(hit, q.ray.tfar * footprint_scale / cos_view);
+    for (std::size_t k = 0; k < lights; ++k) {
+      scenes::ShadowRay sr;
+      if (!scene_.shadowRay(static_cast<int>(k), hit, &sr)) continue;
+      s.light[ri * lights + k] = scenes::LightSample{sr.direction, sr.e_normal};
+      s.shadow.emplace_back();
+      scenes::setRay(s.shadow.back(), sr.origin, sr.direction, 0.0f, sr.t_far);
+      s.shadow_slot.push_back(static_cast<std::uint32_t>(ri * lights + k));
     }
   }
-  if (!shadow.empty())
-    rtcOccluded1M(scene_.embree(), &coherent, shadow.data(), static_cast<unsigned>(shadow.size()), sizeof(RTCRay));
-  for (std::size_t i = 0; i < shadow.size(); ++i)
-    if (shadow[i].tfar >= 0.0f) visible[shadow_slot[i]] = 1;  // occluded rays get tfar = -inf
+  counts->shadow_rays = s.shadow.size();
+  if (!s.shadow.empty())
+    rtcOccluded1M(scene_.embree(), &coherent, s.shadow.data(), static_cast<unsigned>(s.shadow.size()), sizeof(RTCRay));
+  for (std::size_t i = 0; i < s.shadow.size(); ++i)
+    if (s.shadow[i].tfar < 0.0f) s.light[s.shadow_slot[i]].e_normal = 0.0f;  // occluded: tfar = -inf
 
   // Outputs.
-  for (int y = y0, r = 0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x, r += per_pixel) {
-      const auto c = static_cast<std::size_t>(r);  // centre ray
+  const float inv_rays = 1.0f / static_cast<float>(per_pixel - (super ? 1 : 0));
+  ri = 0;
+  for (int y = y0; y < y1; ++y) {
+    float* radiance = out->radiance.ptr<float>(y);
+    float* depth = out->depth.ptr<float>(y);
+    cv::Vec3f* normal = out->normal.ptr<cv::Vec3f>(y);
+    cv::Vec2f* flow = velocity ? out->flow.ptr<cv::Vec2f>(y) : nullptr;
+    for (int x = x0; x < x1; ++x, ri += static_cast<std::size_t>(per_pixel)) {
       const Eigen::Vector3f& b = bearings_[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
       if (std::isnan(b.x())) {
-        out->radiance.at<float>(y, x) = 0.0f;
-        out->depth.at<float>(y, x) = kNaN;
-        out->normal.at<cv::Vec3f>(y, x) = cv::Vec3f(0.0f, 0.0f, 0.0f);
-        if (velocity) out->flow.at<cv::Vec2f>(y, x) = cv::Vec2f(kNaN, kNaN);
+        radiance[x] = 0.0f;
+        depth[x] = kNaN;
+        normal[x] = cv::Vec3f(0.0f, 0.0f, 0.0f);
+        if (flow) flow[x] = cv::Vec2f(kNaN, kNaN);
         continue;
       }
       // Radiance: the centre ray, or the mean of the n² sub-pixel rays.
       float sum = 0.0f;
-      const int first = super ? 1 : 0;
-      for (int s = first; s < per_pixel; ++s) {
-        const auto ri = static_cast<std::size_t>(r + s);
-        if (rh[ri].hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-          sum += rh[ri].ray.tnear <= rh[ri].ray.tfar ? scene_.background(dirs[ri]) : 0.0f;
-          continue;
-        }
-        sum += scene_.radiance(hits[ri], -dirs[ri], albedo[ri], &visible[ri * static_cast<std::size_t>(lights)]);
+      for (std::size_t k = super ? 1 : 0; k < static_cast<std::size_t>(per_pixel); ++k) {
+        const std::size_t r = ri + k;
+        if (s.rays[r].hit.geomID == RTC_INVALID_GEOMETRY_ID)
+          sum += s.rays[r].ray.tnear <= s.rays[r].ray.tfar ? scene_.background(s.dirs[r]) : 0.0f;
+        else
+          sum += scene_.radiance(s.hits[r], -s.dirs[r], s.albedo[r], &s.light[r * lights]);
       }
-      out->radiance.at<float>(y, x) = sum / static_cast<float>(per_pixel - first);
-      const bool hit = rh[c].hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      const float range = rh[c].ray.tfar;
-      out->depth.at<float>(y, x) = hit ? range * b.z() : kInf;
-      const Eigen::Vector3f nrm = hit ? hits[c].n : Eigen::Vector3f::Zero();
-      out->normal.at<cv::Vec3f>(y, x) = cv::Vec3f(nrm.x(), nrm.y(), nrm.z());
-      if (velocity) {
+      radiance[x] = super ? sum * inv_rays : sum;
+      const bool hit = s.rays[ri].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      const float range = s.rays[ri].ray.tfar;
+      depth[x] = hit ? range * b.z() : kInf;
+      if (hit) {
+        const Eigen::Vector3f& nrm = s.hits[ri].n;
+        normal[x] = cv::Vec3f(nrm.x(), nrm.y(), nrm.z());
+      } else {
+        normal[x] = cv::Vec3f(0.0f, 0.0f, 0.0f);
+      }
+      if (flow) {
         Vec2 f;
         const Vec3 bd = b.cast<double>();
         const bool ok = hit ? pointFlow(camera_, bd * static_cast<double>(range), *velocity, &f)
                             : directionFlow(camera_, bd, *velocity, &f);
-        out->flow.at<cv::Vec2f>(y, x) =
-            ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
+        flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
       }
     }
+  }
 }
 
 }  // namespace evio::simulator

@@ -7,6 +7,8 @@
 #include "evio/core/error.h"
 #include "evio/core/io/image_file.h"
 #include "evio/scenes/light.h"
+#include "evio/scenes/mip_map.h"
+#include "evio/scenes/value_noise.h"
 #include "evio/scenes/material.h"
 #include "evio/scenes/noise.h"
 #include "evio/scenes/texture.h"
@@ -36,12 +38,13 @@ TEST(Noise, DeterministicBoundedAndZeroOnTheLattice) {
 
 TEST(Noise, FootprintDropsFineOctaves) {
   const Eigen::Vector3f p(0.3f, 0.7f, 0.2f);
-  // With a footprint of 0.3 only octaves of wavelength > 0.6 count:
-  // octave 0 (wavelength 1) fully... its ratio is 1/0.3 = 3.33 → weight 0.67.
+  // Footprint 0.15: octave 0 (wavelength 1 = 6.67 footprints) is faded to
+  // (6.67 - 4) / 4, octave 1 (3.33 footprints) and finer are dropped.
   const float full = noise::fbm3(p, 1, 0.5f, 9);
-  const float lod = noise::fbm3(p, 6, 0.5f, 9, 0.3f);
+  EXPECT_EQ(full, noise::gradient3(p, 9));
+  const float lod = noise::fbm3(p, 6, 0.5f, 9, 0.15f);
   const float norm6 = (1.0f - std::pow(0.5f, 6.0f)) / 0.5f;  // Σ 0.5^o, o < 6
-  EXPECT_NEAR(lod, full * (1.0f / 0.3f - 2.0f) * 0.5f / norm6, 1e-6f);
+  EXPECT_NEAR(lod, full * (1.0f / 0.15f - 4.0f) * 0.25f / norm6, 1e-6f);
   EXPECT_EQ(noise::fbm3(p, 6, 0.5f, 9, 10.0f), 0.0f);  // everything below the footprint
 }
 
@@ -92,6 +95,43 @@ TEST(Texture, ImageIsSampledAtTexelCentres) {
     EXPECT_NE(std::string(e.what()).find("scene.yaml:4: materials[0].albedo.path"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("missing.png"), std::string::npos) << e.what();
   }
+}
+
+TEST(MipMap, LevelsAverageAndLookupsFilter) {
+  cv::Mat img(4, 4, CV_32FC1);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) img.at<float>(y, x) = static_cast<float>((x + y) % 2);  // 1-texel checker
+  const MipMap mip(img, true);
+  ASSERT_EQ(mip.levels(), 3);  // 4x4, 2x2, 1x1
+  EXPECT_FLOAT_EQ(mip.level(1).at<float>(0, 1), 0.5f);
+  EXPECT_FLOAT_EQ(mip.level(2).at<float>(0, 0), 0.5f);
+  EXPECT_FLOAT_EQ(mip.sample(1.5f, 0.5f, 0.0f), 1.0f);   // texel (1, 0) exactly
+  EXPECT_FLOAT_EQ(mip.sample(1.0f, 0.5f, 0.0f), 0.5f);   // between texels 0 and 1
+  EXPECT_FLOAT_EQ(mip.sample(1.5f, 0.5f, 4.0f), 0.5f);   // a 4-texel footprint sees the mean
+  EXPECT_FLOAT_EQ(mip.sample(5.5f, 4.5f, 0.0f), mip.sample(1.5f, 0.5f, 0.0f));  // repeat
+  const MipMap clamped(img, false);
+  EXPECT_FLOAT_EQ(clamped.sample(-3.0f, 0.5f, 0.0f), 0.0f);  // clamped to texel (0, 0)
+}
+
+TEST(ValueNoise, DeterministicBoundedAndFootprintLimited) {
+  const noise::ValueLattice a(5), b(5), c(6);
+  float lo = 1, hi = -1;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3f p(0.173f * static_cast<float>(i), 0.071f * static_cast<float>(i % 31), 0.37f);
+    const float v = a.fbm(p, 6, 0.6f);
+    ASSERT_EQ(v, b.fbm(p, 6, 0.6f));
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  EXPECT_LE(hi, 1.0f);
+  EXPECT_GE(lo, -1.0f);
+  EXPECT_GT(hi - lo, 0.5f);
+  const Eigen::Vector3f p(3.3f, 1.7f, 0.2f);
+  EXPECT_NE(a.value(p), c.value(p));
+  EXPECT_EQ(a.value(Eigen::Vector3f(3, 1, 0)), a.value(Eigen::Vector3f(3 + 64, 1 - 64, 128)));  // period 64
+  // Footprint 0.2: octave 0 (5 footprints) at weight 0.25, the rest dropped.
+  const float norm = (1.0f - std::pow(0.6f, 6.0f)) / 0.4f;
+  EXPECT_NEAR(a.fbm(p, 6, 0.6f, 0.2f), 0.25f * a.fbm(p, 1, 0.6f) / norm, 1e-6f);
 }
 
 TEST(Texture, NoiseAlbedoStaysInRangeAndVaries) {

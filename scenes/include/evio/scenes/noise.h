@@ -36,10 +36,11 @@ double fbm2(double x, double y, int octaves, double gain, std::uint32_t seed,
             double lacunarity = 2.0);
 
 /// Multi-octave 3-D gradient noise with level of detail: octaves whose
-/// wavelength (1 / frequency, in units of p) is below 2 · footprint are left
-/// out and the last one kept is faded in linearly, so that detail finer than a
-/// pixel does not alias. footprint = 0 keeps every octave. Normalised by the
-/// full Σ gain^o (the value shrinks towards 0 as detail is dropped).
+/// wavelength (1 / frequency, in units of p) is at most 4 · footprint are
+/// left out and those between 4 and 8 footprints faded in linearly, so that
+/// detail finer than a few pixels does not alias (and flicker into false
+/// events). footprint = 0 keeps every octave. Normalised by the full
+/// Σ gain^o (the value shrinks towards 0 as detail is dropped).
 float fbm3(const Eigen::Vector3f& p, int octaves, float gain, std::uint32_t seed,
            float footprint = 0.0f);
 

@@ -46,6 +46,7 @@ struct SceneMesh {
   int material = 0;                   ///< index into the scene's materials
   bool solid = true;                  ///< back side is inside matter
   TriangleMesh mesh;                  ///< positions (m), unit vertex normals, uv (m)
+  std::vector<Eigen::Vector3f> face_normals;  ///< unit geometric normal per triangle (front side)
 };
 
 /// Timings (wall clock, s) and sizes of the build.
@@ -72,11 +73,21 @@ struct SurfaceHit {
   bool back_face = false;  ///< the ray met the back of the triangle
 };
 
-/// An occlusion ray towards a light: origin, unit direction, length.
+/// An occlusion ray towards a light: origin, unit direction, length, and the
+/// light's irradiance on a surface facing it at the hit (W/m²).
 struct ShadowRay {
   Eigen::Vector3f origin;
   Eigen::Vector3f direction;
   float t_far = 0.0f;
+  float e_normal = 0.0f;
+};
+
+/// What one light delivers at a hit: the unit direction towards it and its
+/// irradiance on a surface facing it (W/m²); 0 when it is blocked or cannot
+/// reach the point.
+struct LightSample {
+  Eigen::Vector3f wi = Eigen::Vector3f::UnitZ();
+  float e_normal = 0.0f;
 };
 
 class Scene {
@@ -100,7 +111,14 @@ class Scene {
   /// The surface point of an Embree hit (geomID, primID, u, v) of the ray
   /// org + t·dir.
   SurfaceHit surfaceHit(unsigned geom, unsigned prim, float u, float v,
-                        const Eigen::Vector3f& dir) const;
+                        const Eigen::Vector3f& dir) const {
+    SurfaceHit h;
+    surfaceHit(geom, prim, u, v, dir, &h);
+    return h;
+  }
+  /// The same, written into *hit (no copy; for the renderer's inner loop).
+  void surfaceHit(unsigned geom, unsigned prim, float u, float v, const Eigen::Vector3f& dir,
+                  SurfaceHit* hit) const;
 
   /// Albedo ρ at a hit; footprint_m is the pixel size on the surface (m).
   float albedo(const SurfaceHit& hit, float footprint_m) const;
@@ -113,9 +131,10 @@ class Scene {
   bool shadowRay(int k, const SurfaceHit& hit, ShadowRay* ray) const;
 
   /// Radiance (W/(m²·sr)) leaving `hit` towards `to_viewer` (unit), given the
-  /// albedo and visible[k] ∈ {0, 1} for each shadow light.
+  /// albedo and one LightSample per shadow light (e_normal = 0 when the
+  /// light's occlusion ray was blocked or shadowRay returned false).
   float radiance(const SurfaceHit& hit, const Eigen::Vector3f& to_viewer, float albedo,
-                 const unsigned char* visible) const;
+                 const LightSample* lights) const;
 
   /// Radiance of a ray that leaves the scene in direction `dir`: the sky
   /// radiance upwards (dir_z > 0), 0 otherwise. The sun disc is not drawn.

@@ -6,9 +6,19 @@
 /// Procedural textures are pure functions of the world point p_W (m) or of
 /// the surface coordinates uv (m; see each generator) and a seed, so a static
 /// scene looks the same at every render. `footprint_m`, the size of one pixel
-/// on the surface, drops noise octaves finer than about two pixels
-/// (noise::fbm3) and antialiases shape edges, so that sub-pixel detail does
+/// on the surface, drops noise octaves finer than about four pixels
+/// (value_noise.h) and antialiases shape edges, so that sub-pixel detail does
 /// not alias into flicker (false events).
+///
+/// image: mip-mapped (mip_map.h) with the footprint in texels.
+/// shapes, collage: evaluated once at build on a grid of texels of 1/8 of the
+/// smallest shape radius (at most 4096² texels over region_m, antialiased),
+/// then looked up like an image; outside region_m: the background.
+/// noise: a = d + r_w · (r − d) with the rock weight
+///   r_w = smoothstep(θ − 0.08, θ + 0.08, n(p / λ_patch)) (one octave),
+///   θ = 0.5 (0.5 − rock_fraction), then the detail
+///   ρ = clamp(a · (1 + 1.6 c · fbm(p / λ_detail, octaves, gain 0.6)), 0, 1)
+/// (d, r the dust and rock albedo, c the detail contrast).
 
 #include <cstdint>
 #include <memory>
@@ -19,6 +29,8 @@
 
 #include "evio/core/eigen_types.h"
 #include "evio/core/options.h"
+#include "evio/scenes/mip_map.h"
+#include "evio/scenes/value_noise.h"
 
 namespace evio::scenes {
 
@@ -118,14 +130,22 @@ class Texture {
     int sides;  ///< 0 = circle, else regular polygon with this many sides
   };
   float noise(const Eigen::Vector3f& p, float footprint) const;
-  float image(const Eigen::Vector2f& uv) const;
+  float image(const Eigen::Vector2f& uv, float footprint) const;
   float shapes(const Eigen::Vector2f& uv, float footprint, float background) const;
+  float collage(const Eigen::Vector2f& uv, float footprint) const;
 
   TextureOptions options_;
   std::uint32_t seed_;
   enum class Kind { kConstant, kChecker, kNoise, kImage, kShapes, kCollage } kind_;
+  std::unique_ptr<noise::ValueLattice> lattice_;  ///< noise and collage
+  struct NoiseConstants {  ///< the noise texture's options, as the inner loop uses them
+    float inv_patch_wl = 1.0f, inv_detail_wl = 1.0f, threshold = 0.0f;
+    float dust = 0.0f, rock_minus_dust = 0.0f, contrast = 0.0f;
+  } noise_;
   cv::Mat image_;  ///< CV_32FC1
   std::vector<Shape> shapes_;
+  MipMap mip_;            ///< image, or the baked shapes/collage texture
+  float texel_m_ = 0.0f;  ///< baked texel size (shapes, collage)
 };
 
 }  // namespace evio::scenes

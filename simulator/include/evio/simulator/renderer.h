@@ -17,6 +17,7 @@
 /// nothing but its own rays, so the output is bit-identical whatever the
 /// number of threads.
 
+#include <cstdint>
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
@@ -57,15 +58,22 @@ struct RenderOutput {
   cv::Mat flow;      ///< CV_32FC2, (u̇, v̇) in px/s (motion_field.h); empty without a velocity
 };
 
+/// Ray counts of one render (for throughput figures).
+struct RenderStats {
+  std::uint64_t camera_rays = 0;  ///< primary rays traced (inactive ones excluded)
+  std::uint64_t shadow_rays = 0;  ///< occlusion rays traced
+};
+
 class Renderer {
  public:
   /// Keeps references to `scene` (which must outlive the renderer); copies the camera.
   Renderer(const scenes::Scene& scene, const Camera& camera, const RendererOptions& options = {});
 
   /// Renders the view from T_W_C (camera C in world W). With `velocity`, also
-  /// the motion field. Throws Error (naming the source) when
-  /// check_viewpoint is on and the camera is inside a solid source.
-  RenderOutput render(const Pose& T_W_C, const CameraVelocity* velocity = nullptr) const;
+  /// the motion field; with `stats`, the ray counts. Throws Error (naming the
+  /// source) when check_viewpoint is on and the camera is inside a solid source.
+  RenderOutput render(const Pose& T_W_C, const CameraVelocity* velocity = nullptr,
+                      RenderStats* stats = nullptr) const;
 
   /// Unit bearing in C of the centre ray of pixel (x, y); NaN when the model
   /// cannot unproject that pixel.
@@ -78,7 +86,9 @@ class Renderer {
   const RendererOptions& options() const { return options_; }
 
  private:
-  void renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out) const;
+  struct Scratch;
+  void renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
+                  RenderStats* counts, Scratch* scratch) const;
 
   const scenes::Scene& scene_;
   Camera camera_;

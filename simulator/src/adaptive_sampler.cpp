@@ -37,14 +37,29 @@ cv::Mat AdaptiveSampler::logImage(const cv::Mat& radiance) const {
 
 float AdaptiveSampler::logRateAt(const cv::Mat& log_image, const cv::Mat& flow, int x, int y) const {
   const int w = log_image.cols, h = log_image.rows;
-  const int x0 = std::max(0, x - 1), x1 = std::min(w - 1, x + 1);
-  const int y0 = std::max(0, y - 1), y1 = std::min(h - 1, y + 1);
-  const float gx = x1 > x0 ? (log_image.at<float>(y, x1) - log_image.at<float>(y, x0)) / static_cast<float>(x1 - x0)
-                           : 0.0f;
-  const float gy = y1 > y0 ? (log_image.at<float>(y1, x) - log_image.at<float>(y0, x)) / static_cast<float>(y1 - y0)
-                           : 0.0f;
   const cv::Vec2f f = flow.at<cv::Vec2f>(y, x);
-  const float rate = std::abs(gx * f[0] + gy * f[1]);
+  float rate = 0.0f;
+  if (options_.rate_bound) {
+    const float l = log_image.at<float>(y, x);
+    float slope = 0.0f;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int qx = x + dx, qy = y + dy;
+        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+        const float d = std::abs(log_image.at<float>(qy, qx) - l) * (dx != 0 && dy != 0 ? 0.70710678f : 1.0f);
+        if (d > slope) slope = d;  // NaN never wins
+      }
+    // The steepest of 8 directions is within 22.5° of ∇L: slope / cos 22.5° >= ‖∇L‖ for linear L.
+    rate = slope * 1.0823922f * std::sqrt(f[0] * f[0] + f[1] * f[1]);
+  } else {
+    const int x0 = std::max(0, x - 1), x1 = std::min(w - 1, x + 1);
+    const int y0 = std::max(0, y - 1), y1 = std::min(h - 1, y + 1);
+    const float gx = x1 > x0 ? (log_image.at<float>(y, x1) - log_image.at<float>(y, x0)) / static_cast<float>(x1 - x0)
+                             : 0.0f;
+    const float gy = y1 > y0 ? (log_image.at<float>(y1, x) - log_image.at<float>(y0, x)) / static_cast<float>(y1 - y0)
+                             : 0.0f;
+    rate = std::abs(gx * f[0] + gy * f[1]);
+  }
   return std::isfinite(rate) ? rate : 0.0f;
 }
 

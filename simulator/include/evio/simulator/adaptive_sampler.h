@@ -8,14 +8,21 @@
 /// the rate of change of a pixel's log radiance L = log(ε + I):
 ///     dL/dt = −∇L · u̇v         (∇L in 1/px, u̇v the motion field in px/s),
 /// so the next sample of a pixel is due after
-///     Δt = clamp(λ C / |∇L · u̇v|, 1 / max_rate_hz, 1 / min_rate_hz),
+///     Δt = clamp(λ C / Ṙ, 1 / max_rate_hz, 1 / min_rate_hz),
 /// when its L is predicted to have changed by λ C (C the smaller contrast
-/// threshold, λ = 0.5 by default). ESIM's whole-frame rule takes the
-/// smallest Δt over the image for every pixel (wholeFrameInterval); the
-/// per-pixel rule re-samples only the pixels that need it. ∇L is taken by
-/// central differences (one-sided at the image border); NaN flow or radiance
-/// counts as no change. With tile_px > 1 every pixel of a tile gets the
-/// tile's smallest Δt (a renderer can then re-trace whole tiles).
+/// threshold, λ = 0.5 by default), with the predicted rate Ṙ either
+///   - rate_bound = true (default): Ṙ = g / cos 22.5° · ‖u̇v‖, g = max over
+///     the 8 neighbours q of |L(q) − L(p)| / ‖q − p‖ (g / cos 22.5° ≥ ‖∇L‖
+///     when L is linear over the neighbourhood): a bound that holds for any
+///     flow direction and does not vanish at extrema of L, where ∇L = 0 but
+///     the texture moving past still changes L;
+///   - rate_bound = false: Ṙ = |∇L · u̇v| (ESIM's first-order prediction), ∇L
+///     by central differences (one-sided at the border).
+/// ESIM's whole-frame rule takes the smallest Δt over the image for every
+/// pixel (wholeFrameInterval); the per-pixel rule re-samples only the pixels
+/// that need it. NaN flow or radiance counts as no change. With tile_px > 1
+/// every pixel of a tile gets the tile's smallest Δt (a renderer can then
+/// re-trace whole tiles).
 ///
 /// In a render loop: after rendering the pixels due at t (and feeding them to
 /// EventCamera::updatePixel), call schedulePixel (or schedule for a whole
@@ -40,6 +47,7 @@ class AdaptiveSampler {
     double min_rate_hz = 30.0;    ///< every pixel is sampled at least this often, Hz
     double max_rate_hz = 1e5;     ///< no pixel is sampled more often than this, Hz
     int tile_px = 1;              ///< 1 = per pixel; n > 1 = per n × n tile
+    bool rate_bound = true;       ///< Ṙ = max neighbour slope · ‖u̇v‖ (true) or |∇L · u̇v| (false)
 
     template <class V>
     void fields(V& v) {
@@ -47,6 +55,7 @@ class AdaptiveSampler {
       v("min_rate_hz", min_rate_hz, "minimum sample rate, Hz");
       v("max_rate_hz", max_rate_hz, "maximum sample rate, Hz");
       v("tile_px", tile_px, "1 = per pixel, n = per n x n tile");
+      v("rate_bound", rate_bound, "predict with max neighbour slope * |flow| (else |grad L . flow|)");
     }
     void validate() const;
   };
@@ -58,7 +67,7 @@ class AdaptiveSampler {
   /// L = log(ε + max(I, 0)) of a CV_32FC1 radiance image (CV_32FC1).
   cv::Mat logImage(const cv::Mat& radiance) const;
 
-  /// |∇L · u̇v| at pixel (x, y) of a log image and a CV_32FC2 motion field (1/s).
+  /// The predicted rate Ṙ (1/s) at pixel (x, y) of a log image and a CV_32FC2 motion field.
   float logRateAt(const cv::Mat& log_image, const cv::Mat& flow, int x, int y) const;
 
   /// The sample interval for a predicted |dL/dt| (1/s), ns, within the rate bounds.

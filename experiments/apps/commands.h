@@ -9,5 +9,7 @@ namespace evio::apps {
 
 void addInfoCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
+void addTrackCommand(CLI::App& app);
+void addEvaluateTracksCommand(CLI::App& app);
 
 }  // namespace evio::apps

@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "evio 0.1.0");
   evio::apps::addInfoCommand(app);
   evio::apps::addTrajectoryCommand(app);
+  evio::apps::addTrackCommand(app);
+  evio::apps::addEvaluateTracksCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -4,7 +4,10 @@
 
 #include <cmath>
 
+#include "evio/core/io/config.h"
 #include "evio/core/so3.h"
+#include "evio/estimator/frontend/frontend.h"
+#include "evio/estimator/frontend/synchronizer.h"
 #include "evio/estimator/frontend/event_prefilter.h"
 #include "evio/estimator/frontend/gyro_predictor.h"
 #include "evio/estimator/frontend/image_reconstructor.h"
@@ -155,6 +158,37 @@ TEST(GyroPredictor, IntegratesConstantRateAndPredictsRotatedProjection) {
   ASSERT_TRUE(uv1.has_value());
   EXPECT_LT((*uv1 - expected).norm(), 1e-9);
   EXPECT_GT((*uv1 - uv0).norm(), 10.0);  // it did move
+}
+
+TEST(FrontendOptions, DefaultsRoundTripThroughYamlAndOverridesAreChecked) {
+  const FrontendOptions defaults;
+  FrontendOptions back;
+  config::fill(config::loadString(config::toYaml(defaults), "defaults.yaml"), "", back);
+  EXPECT_TRUE(config::equal(defaults, back));
+  // The reference values (ALGORITHMS.md) are the defaults.
+  EXPECT_EQ(defaults.eklt.patch_size_px, 19);
+  EXPECT_EQ(defaults.eklt.max_features, 60);
+  EXPECT_EQ(defaults.eklt.min_features, 45);
+  EXPECT_DOUBLE_EQ(defaults.eklt.batch_displacement_px, 0.6);
+  EXPECT_EQ(defaults.eklt.batch_min_events, 5);
+  EXPECT_EQ(defaults.eklt.batch_max_events, 500);
+  EXPECT_DOUBLE_EQ(defaults.eklt.min_tracking_quality, 0.6);
+  EXPECT_EQ(defaults.eklt.max_iterations, 25);
+  EXPECT_EQ(defaults.klt.fast_threshold, 20);
+  EXPECT_DOUBLE_EQ(defaults.klt.ransac_threshold_px, 0.6);
+  EXPECT_EQ(SynchronizerOptions{}.n_e, 3200);
+
+  auto doc = config::loadString("tracker: klt\n", "t.yaml");
+  config::applyOverride(doc, "eklt.patch_size_px=17");
+  FrontendOptions o;
+  config::fill(doc, "", o);
+  EXPECT_EQ(o.tracker, "klt");
+  EXPECT_EQ(o.eklt.patch_size_px, 17);
+  for (const char* bad : {"eklt:\n  patch_size_px: 18\n", "tracker: orb\n", "eklt:\n  solver: gn\n",
+                          "image_source: video\n", "prefilter:\n  random_keep_one_in: 0\n", "eklt:\n  pach: 3\n"}) {
+    FrontendOptions x;
+    EXPECT_THROW(config::fill(config::loadString(bad, "bad.yaml"), "", x), Error) << bad;
+  }
 }
 
 }  // namespace

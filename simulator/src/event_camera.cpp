@@ -5,7 +5,9 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -22,6 +24,55 @@ constexpr std::size_t kChunk = 256;      // pixels per vectorised chunk
 constexpr std::size_t kBlock = 16384;    // pixels per parallel block
 constexpr float kTwoPi = 2.0f * std::numbers::pi_v<float>;
 
+/// Sorts pending events by (t, pixel, label, polarity). When (t − t_min,
+/// pixel, label, polarity) packs into 64 bits, an LSD radix sort on the
+/// packed keys (8-bit digits, only the passes the key width needs); else a
+/// comparison sort. Both give the same order.
+bool pendingLess(const EventCamera::Pending& a, const EventCamera::Pending& b);
+
+void sortPending(std::vector<EventCamera::Pending>::iterator begin, std::vector<EventCamera::Pending>::iterator end,
+                 std::size_t pixel_count, std::vector<std::uint64_t>* keys, std::vector<std::uint64_t>* scratch) {
+  const auto count = static_cast<std::size_t>(end - begin);
+  if (count < 2) return;
+  TimeNs t_min = begin->t_ns, t_max = begin->t_ns;
+  for (auto it = begin; it != end; ++it) {
+    t_min = std::min(t_min, it->t_ns);
+    t_max = std::max(t_max, it->t_ns);
+  }
+  const int pixel_bits = std::bit_width(static_cast<std::uint64_t>(pixel_count - 1));
+  const int time_bits = std::bit_width(static_cast<std::uint64_t>(t_max - t_min));
+  const int low_bits = pixel_bits + 3;  // pixel, label (2 bits), polarity (1 bit)
+  if (count < 64 || time_bits + low_bits > 64) {
+    std::sort(begin, end, pendingLess);
+    return;
+  }
+  keys->resize(count);
+  scratch->resize(count);
+  std::size_t j = 0;
+  for (auto it = begin; it != end; ++it, ++j)
+    (*keys)[j] = (static_cast<std::uint64_t>(it->t_ns - t_min) << low_bits) |
+                 (static_cast<std::uint64_t>(it->pixel) << 3) | (static_cast<std::uint64_t>(it->label) << 1) |
+                 static_cast<std::uint64_t>(it->positive);
+  const int passes = (time_bits + low_bits + 7) / 8;
+  for (int pass = 0; pass < passes; ++pass) {
+    const int shift = 8 * pass;
+    std::size_t histogram[257] = {};
+    for (const std::uint64_t k : *keys) ++histogram[((k >> shift) & 0xFF) + 1];
+    for (int d = 0; d < 256; ++d) histogram[d + 1] += histogram[d];
+    for (const std::uint64_t k : *keys) (*scratch)[histogram[(k >> shift) & 0xFF]++] = k;
+    keys->swap(*scratch);
+  }
+  const std::uint64_t pixel_mask = (std::uint64_t{1} << pixel_bits) - 1;
+  j = 0;
+  for (auto it = begin; it != end; ++it, ++j) {
+    const std::uint64_t k = (*keys)[j];
+    it->t_ns = t_min + static_cast<TimeNs>(k >> low_bits);
+    it->pixel = static_cast<std::uint32_t>((k >> 3) & pixel_mask);
+    it->label = static_cast<EventLabel>((k >> 1) & 3);
+    it->positive = static_cast<std::uint8_t>(k & 1);
+  }
+}
+
 bool pendingLess(const EventCamera::Pending& a, const EventCamera::Pending& b) {
   if (a.t_ns != b.t_ns) return a.t_ns < b.t_ns;
   if (a.pixel != b.pixel) return a.pixel < b.pixel;
@@ -30,8 +81,11 @@ bool pendingLess(const EventCamera::Pending& a, const EventCamera::Pending& b) {
 }
 
 /// (1 − e^(−x)) / x for x ≥ 0, given e = e^(−x); its series below 10⁻³.
+/// Both branches are computed so that loops over pixels vectorise.
 inline float phiOf(float x, float e) {
-  return x < 1e-3f ? 1.0f - x * (0.5f - x * (1.0f / 6.0f)) : (1.0f - e) / x;
+  const float series = 1.0f - x * (0.5f - x * (1.0f / 6.0f));
+  const float direct = (1.0f - e) / (x + 1e-30f);
+  return x < 1e-3f ? series : direct;
 }
 
 /// Constants of the per-pixel arithmetic, shared by the block and the
@@ -207,7 +261,8 @@ void EventCamera::update(TimeNs t_ns, const float* radiance, EventArray* events,
     initialize(t_ns, radiance);
     return;
   }
-  require(t_ns > t_max_sample_, "EventCamera::update: time " + std::to_string(t_ns) +
+  if (t_ns <= t_max_sample_)
+    throw Error("EventCamera::update: time " + std::to_string(t_ns) +
                                     " ns is not after the last sample " + std::to_string(t_max_sample_) + " ns");
   const std::size_t blocks = (n_ + kBlock - 1) / kBlock;
   block_events_.resize(blocks);
@@ -239,6 +294,7 @@ void EventCamera::processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, 
                                std::vector<Pending>* out) {
   const PixelMath pm(options_);
   float lin[kChunk], lf[kChunk], dt[kChunk], hazard[kChunk], rate[kChunk], v[kChunk];
+  std::uint8_t cross[kChunk + 8] = {}, shot[kChunk + 8] = {};  // + 8: whole 8-byte words at the end
   const bool uniform = uniform_;
   const float dt_uniform = static_cast<float>(t_ns - uniform_t_) * 1e-9f;
   for (std::size_t c = begin; c < end; c += kChunk) {
@@ -266,25 +322,32 @@ void EventCamera::processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, 
         hazard[j] = rate[j] * dt[j];
       }
     }
-    float* ref = ref_.data() + c;
+    // Flags first (vectorised), then the rare slow paths.
+    const float* ref = ref_.data() + c;
     const float* thp = th_pos_.data() + c;
     const float* thn = th_neg_.data() + c;
     const float* lf0 = lf_prev_.data() + c;
-    for (std::size_t j = 0; j < m; ++j) {
-      if (lf[j] - ref[j] >= thp[j] || ref[j] - lf[j] >= thn[j]) {
-        const TimeNs t0 = uniform ? uniform_t_ : t_prev_[c + j];
-        crossings(c + j, t0, t_ns, lf0[j], lf[j], out);
-      }
-    }
+    float* budget = shot_budget_.data() + c;
+    for (std::size_t j = 0; j < m; ++j)
+      cross[j] = static_cast<std::uint8_t>((lf[j] - ref[j] >= thp[j]) | (ref[j] - lf[j] >= thn[j]));
     if (shot_) {
-      float* budget = shot_budget_.data() + c;
       for (std::size_t j = 0; j < m; ++j) {
-        if (hazard[j] >= budget[j]) {
-          const TimeNs t0 = uniform ? uniform_t_ : t_prev_[c + j];
-          shotNoise(c + j, t0, t_ns, hazard[j], rate[j], out);
-        } else {
-          budget[j] -= hazard[j];
-        }
+        const bool event = hazard[j] >= budget[j];
+        shot[j] = static_cast<std::uint8_t>(event);
+        budget[j] -= event ? 0.0f : hazard[j];
+      }
+    } else {
+      std::fill(shot, shot + m, std::uint8_t{0});
+    }
+    for (std::size_t j = 0; j < m; j += 8) {
+      std::uint64_t any_cross = 0, any_shot = 0;  // 8 flags at a time
+      std::memcpy(&any_cross, cross + j, 8);
+      std::memcpy(&any_shot, shot + j, 8);
+      if ((any_cross | any_shot) == 0) continue;
+      for (std::size_t q = j; q < std::min(m, j + 8); ++q) {
+        const TimeNs t0 = uniform ? uniform_t_ : t_prev_[c + q];
+        if (cross[q] != 0) crossings(c + q, t0, t_ns, lf0[q], lf[q], out);
+        if (shot[q] != 0) shotNoise(c + q, t0, t_ns, hazard[q], rate[q], out);
       }
     }
     std::copy(lf, lf + m, lf_prev_.data() + c);
@@ -306,7 +369,7 @@ void EventCamera::crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float
   const auto cross = [&](bool positive) {
     double frac = dl != 0.0 ? (static_cast<double>(r) - static_cast<double>(l0)) / dl : 1.0;
     frac = std::clamp(frac, 0.0, 1.0);
-    const TimeNs t = std::clamp<TimeNs>(t0 + std::llround(frac * span), t0 + 1, t1);
+    const TimeNs t = std::clamp<TimeNs>(t0 + static_cast<TimeNs>(frac * span + 0.5), t0 + 1, t1);
     if (t - t_last_event_[i] >= refractory_ns_) {
       out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
                              EventLabel::kSignal});
@@ -342,7 +405,8 @@ void EventCamera::shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, f
   const double h = static_cast<double>(hazard);
   std::uint32_t k = shot_count_[i];
   while (acc <= h) {
-    const TimeNs t = std::clamp<TimeNs>(t0 + std::llround(acc / static_cast<double>(rate_hz) * 1e9), t0 + 1, t1);
+    const TimeNs t =
+        std::clamp<TimeNs>(t0 + static_cast<TimeNs>(acc / static_cast<double>(rate_hz) * 1e9 + 0.5), t0 + 1, t1);
     const bool positive = counterUniform(key_shot_, i, 2ull * k + 1) < 0.5;
     out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
                            EventLabel::kShot});
@@ -355,13 +419,14 @@ void EventCamera::shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, f
 
 void EventCamera::updatePixel(std::size_t i, TimeNs t_ns, float radiance) {
   require(initialized_, "EventCamera::updatePixel: call initialize() or update() first");
-  require(i < n_, "EventCamera::updatePixel: pixel index " + std::to_string(i) + " out of range");
+  if (i >= n_) throw Error("EventCamera::updatePixel: pixel index " + std::to_string(i) + " out of range");
   if (uniform_) {
     std::fill(t_prev_.begin(), t_prev_.end(), uniform_t_);
     uniform_ = false;
   }
   const TimeNs t0 = t_prev_[i];
-  require(t_ns > t0, "EventCamera::updatePixel: time " + std::to_string(t_ns) + " ns of pixel " +
+  if (t_ns <= t0)
+    throw Error("EventCamera::updatePixel: time " + std::to_string(t_ns) + " ns of pixel " +
                          std::to_string(i) + " is not after its last sample " + std::to_string(t0) + " ns");
   const PixelMath pm(options_);
   const float v = PixelMath::clampRadiance(radiance);
@@ -421,15 +486,28 @@ void EventCamera::generateTimedNoise(TimeNs up_to) {
 void EventCamera::appendSorted(TimeNs watermark, EventArray* events, std::vector<EventLabel>* labels) {
   const auto ready_end = std::partition(pending_.begin(), pending_.end(),
                                         [watermark](const Pending& p) { return p.t_ns <= watermark; });
-  std::sort(pending_.begin(), ready_end, pendingLess);
+  sortPending(pending_.begin(), ready_end, n_, &sort_keys_, &sort_scratch_);
+  const auto count = static_cast<std::size_t>(ready_end - pending_.begin());
   if (events != nullptr) {
+    const std::size_t base = events->size();
+    events->resize(base + count);
+    TimeNs* t = events->t().data() + base;
+    std::uint16_t* x = events->x().data() + base;
+    std::uint16_t* y = events->y().data() + base;
+    std::uint8_t* p = events->p().data() + base;
     const auto w = static_cast<std::uint32_t>(width_);
-    for (auto it = pending_.begin(); it != ready_end; ++it)
-      events->push_back(it->t_ns, static_cast<std::uint16_t>(it->pixel % w), static_cast<std::uint16_t>(it->pixel / w),
-                        it->positive != 0);
+    for (std::size_t j = 0; j < count; ++j) {
+      const Pending& e = pending_[j];
+      t[j] = e.t_ns;
+      x[j] = static_cast<std::uint16_t>(e.pixel % w);
+      y[j] = static_cast<std::uint16_t>(e.pixel / w);
+      p[j] = e.positive;
+    }
   }
   if (labels != nullptr) {
-    for (auto it = pending_.begin(); it != ready_end; ++it) labels->push_back(it->label);
+    const std::size_t base = labels->size();
+    labels->resize(base + count);
+    for (std::size_t j = 0; j < count; ++j) (*labels)[base + j] = pending_[j].label;
   }
   pending_.erase(pending_.begin(), ready_end);
 }

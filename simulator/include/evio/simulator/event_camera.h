@@ -217,6 +217,7 @@ class EventCamera {
   TimeNs noise_done_ns_ = 0;                ///< timed noise generated up to here
 
   std::vector<Pending> pending_;
+  std::vector<std::uint64_t> sort_keys_, sort_scratch_;
   std::vector<std::vector<Pending>> block_events_;
   std::uint64_t pixel_updates_ = 0;
 };

@@ -157,6 +157,35 @@ TEST(EkltSolver, LevenbergMarquardtAgreesWithCeres) {
   RecordProperty("max_position_difference_px", std::to_string(max_diff));
 }
 
+// Looser stopping rules for the hot path (|Δcost| ≤ 1e-4·cost, ‖δp‖ ≤ 1e-5·‖p‖,
+// about 10⁻³ px) still land within 0.01 px of the Ceres reference run with its
+// default tolerances, in fewer iterations.
+TEST(EkltSolver, LooseToleranceLmStaysWithinAHundredthOfAPixelOfCeres) {
+  Fixture f;
+  const EventArray events = test::generateEvents(f.tex, f.motion, test::Roi{25, 15, 85, 70}, 0.0, 0.6, 1e-3, 0.02);
+  EkltSolverSettings loose;
+  loose.function_tolerance = 1e-4;
+  loose.parameter_tolerance = 1e-5;
+  int iterations_loose = 0, iterations_tight = 0;
+  for (int k = 0; k < 20; ++k) {
+    const double ta = 0.02 + 0.028 * k;
+    const Vec2 c_acc = f.motion.forward(f.x0, ta) + Vec2(0.3 * std::cos(k), 0.3 * std::sin(k));
+    const std::vector<float> m = eventBatch(events, ta, ta + 0.03, c_acc);
+    const EkltBatch batch{&f.templ, m.data(), kP};
+    const Vec4 p0(-f.motion.omega_rad_s * ta, f.x0.x(), f.x0.y(), std::atan2(-9.0, 12.0) + 0.25);
+    const EkltSolution fast = solveEkltLm(batch, p0, loose);
+    const EkltSolution tight = solveEkltLm(batch, p0, {});
+    const EkltSolution ceres = solveEkltCeres(batch, p0, {});
+    EXPECT_LT((ekltFeaturePosition(fast.p, c_acc, f.x0) - ekltFeaturePosition(ceres.p, c_acc, f.x0)).norm(), 0.01)
+        << "batch " << k;
+    iterations_loose += fast.iterations;
+    iterations_tight += tight.iterations;
+  }
+  EXPECT_LT(iterations_loose, iterations_tight);
+  RecordProperty("iterations_loose", std::to_string(iterations_loose / 20.0));
+  RecordProperty("iterations_tight", std::to_string(iterations_tight / 20.0));
+}
+
 TEST(EkltSolver, ParsesSolverNames) {
   EXPECT_EQ(parseEkltSolverKind("lm"), EkltSolverKind::kLevenbergMarquardt);
   EXPECT_EQ(parseEkltSolverKind("ceres"), EkltSolverKind::kCeres);

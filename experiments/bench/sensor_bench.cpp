@@ -17,8 +17,8 @@
 //       ideal pixel (thresholds with mismatch only), 1 = the full DVXplorer
 //       preset (photoreceptor low-pass, refractory, leak, shot and hot-pixel
 //       noise).
-//   BM_EventCameraPerPixel/<model>/<speed10>  the adaptive path: updatePixel() for every
-//       pixel, then emit(), one thread.
+//   BM_EventCameraPerPixel/<model>/<speed10>  the adaptive path: updatePixels()
+//       with every pixel's index, then emit(), one thread.
 // Counters: pixel_updates_per_s (pixels · samples per second of wall time),
 // events_per_update (events emitted per whole-image sample), peak_rss_MB
 // (VmHWM of the process, input images included: 39 MB) and state_MB (the
@@ -118,13 +118,15 @@ void BM_EventCameraPerPixel(benchmark::State& state) {
   std::int64_t s = 0;
   cam.update(0, images[0].data(), &events, &labels);
   const std::size_t n = cam.pixelCount();
+  std::vector<std::uint32_t> indices(n);
+  for (std::size_t i = 0; i < n; ++i) indices[i] = static_cast<std::uint32_t>(i);
   for (auto _ : state) {
     ++s;
     events.clear();
     labels.clear();
     const float* img = images[static_cast<std::size_t>(frameOf(s))].data();
     const evio::TimeNs t = s * evio::kNsPerMs;
-    for (std::size_t i = 0; i < n; ++i) cam.updatePixel(i, t, img[i]);
+    cam.updatePixels(t, indices.data(), img, n);
     cam.emit(&events, &labels);
     benchmark::DoNotOptimize(events.t().data());
   }

@@ -417,17 +417,34 @@ void EventCamera::shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, f
   shot_budget_[i] = static_cast<float>(acc - h);
 }
 
-void EventCamera::updatePixel(std::size_t i, TimeNs t_ns, float radiance) {
-  require(initialized_, "EventCamera::updatePixel: call initialize() or update() first");
+void EventCamera::beginPerPixel(std::size_t i, TimeNs t_ns) {
+  if (!initialized_) throw Error("EventCamera::updatePixel: call initialize() or update() first");
   if (i >= n_) throw Error("EventCamera::updatePixel: pixel index " + std::to_string(i) + " out of range");
   if (uniform_) {
     std::fill(t_prev_.begin(), t_prev_.end(), uniform_t_);
     uniform_ = false;
   }
+  if (t_ns <= t_prev_[i])
+    throw Error("EventCamera::updatePixel: time " + std::to_string(t_ns) + " ns of pixel " + std::to_string(i) +
+                " is not after its last sample " + std::to_string(t_prev_[i]) + " ns");
+}
+
+void EventCamera::updatePixel(std::size_t i, TimeNs t_ns, float radiance) {
+  beginPerPixel(i, t_ns);
+  stepPixel(i, t_ns, radiance);
+  t_max_sample_ = std::max(t_max_sample_, t_ns);
+  ++pixel_updates_;
+}
+
+void EventCamera::updatePixels(TimeNs t_ns, const std::uint32_t* indices, const float* radiance, std::size_t count) {
+  for (std::size_t k = 0; k < count; ++k) beginPerPixel(indices[k], t_ns);  // all checks before any change
+  for (std::size_t k = 0; k < count; ++k) stepPixel(indices[k], t_ns, radiance[k]);
+  if (count > 0) t_max_sample_ = std::max(t_max_sample_, t_ns);
+  pixel_updates_ += count;
+}
+
+inline void EventCamera::stepPixel(std::size_t i, TimeNs t_ns, float radiance) {
   const TimeNs t0 = t_prev_[i];
-  if (t_ns <= t0)
-    throw Error("EventCamera::updatePixel: time " + std::to_string(t_ns) + " ns of pixel " +
-                         std::to_string(i) + " is not after its last sample " + std::to_string(t0) + " ns");
   const PixelMath pm(options_);
   const float v = PixelMath::clampRadiance(radiance);
   const float lin = pm.logOf(v);
@@ -449,8 +466,6 @@ void EventCamera::updatePixel(std::size_t i, TimeNs t_ns, float radiance) {
   }
   lf_prev_[i] = lf;
   t_prev_[i] = t_ns;
-  t_max_sample_ = std::max(t_max_sample_, t_ns);
-  ++pixel_updates_;
 }
 
 TimeNs EventCamera::emit(EventArray* events, std::vector<EventLabel>* labels) {

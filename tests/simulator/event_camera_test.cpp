@@ -223,7 +223,17 @@ TEST(EventCamera, OutputIsSortedAndIndependentOfThreadsAndPixelOrder) {
   cam.update(0, frameAt(w, h, 0).data(), &c.events, &c.labels);
   for (int k = 1; k <= 60; ++k) {
     const auto img = frameAt(w, h, k);
-    for (std::size_t i = img.size(); i-- > 0;) cam.updatePixel(i, k * 500'000, img[i]);
+    if (k % 2 == 0) {
+      for (std::size_t i = img.size(); i-- > 0;) cam.updatePixel(i, k * 500'000, img[i]);
+    } else {  // the batch call, pixels in a shuffled order
+      std::vector<std::uint32_t> idx(img.size());
+      std::vector<float> val(img.size());
+      for (std::size_t q = 0; q < img.size(); ++q) {
+        idx[q] = static_cast<std::uint32_t>((q * 7919) % img.size());
+        val[q] = img[idx[q]];
+      }
+      cam.updatePixels(k * 500'000, idx.data(), val.data(), idx.size());
+    }
     EXPECT_EQ(cam.emit(&c.events, &c.labels), k * 500'000);
   }
   EXPECT_TRUE(a.events == c.events);

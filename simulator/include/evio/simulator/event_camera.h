@@ -49,8 +49,9 @@
 ///    (the first call only sets the references and emits nothing). Every
 ///    event up to t is emitted, time-sorted, appended to `events`.
 ///  - Adaptive, per pixel: after one whole-frame `update` (or `initialize`),
-///    feed the pixels of each render with `updatePixel(i, t, I)` (each pixel's
-///    times strictly increasing), then call `emit(&events, &labels)` once per
+///    feed the pixels of each render with `updatePixels(t, indices, I, n)` or
+///    `updatePixel(i, t, I)` (each pixel's times strictly increasing; the
+///    same result either way), then call `emit(&events, &labels)` once per
 ///    render: it appends, time-sorted, every event at or before the watermark
 ///    = the earliest last-sample time over all pixels, and keeps the rest
 ///    pending. Events after the watermark can still be preceded by events of
@@ -142,6 +143,11 @@ class EventCamera {
   /// otherwise). Its events wait in the pending buffer until emit().
   void updatePixel(std::size_t index, TimeNs t_ns, float radiance);
 
+  /// The pixels indices[0 … count) all sampled at t_ns with radiance[k]
+  /// (e.g. the pixels one render re-traced): the same as updatePixel for
+  /// each, faster; every sample is checked before any pixel changes.
+  void updatePixels(TimeNs t_ns, const std::uint32_t* indices, const float* radiance, std::size_t count);
+
   /// Appends, time-sorted, the pending events at or before the watermark
   /// (min over pixels of the last sample time) plus the leak and hot-pixel
   /// noise up to it; returns the watermark. O(pixels + pending events).
@@ -177,6 +183,8 @@ class EventCamera {
   };
 
  private:
+  void beginPerPixel(std::size_t i, TimeNs t_ns);
+  void stepPixel(std::size_t i, TimeNs t_ns, float radiance);
   void processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, const float* radiance,
                     std::vector<Pending>* out);
   void crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float l1, std::vector<Pending>* out);

@@ -11,17 +11,22 @@
 //                  ray streams (rtcIntersect1M/rtcOccluded1M, coherent flag)
 //                  and thread count as the renderer, no shading, no output;
 //   BM_Render      the full renderer (radiance, depth, normal; no flow).
-// Counters: rays_per_s_per_core (camera + occlusion rays traced / wall time /
-// threads), renders_per_s, peak_rss_MB (VmHWM). BM_SceneBuild/<preset>
-// reports the scene build time (generation, BVH, indirect light). The
-// benchmark argument is the thread count (1 by default, --threads... see
-// kThreads).
+// The benchmark argument is the thread count (1 and 2). Counters:
+//   rays_per_s_per_core  camera + occlusion rays traced per second of process
+//                        CPU time (CLOCK_PROCESS_CPUTIME_ID), i.e. per busy
+//                        core; robust against other load on the machine;
+//   renders_per_s        frames per second of wall-clock time;
+//   peak_rss_MB          VmHWM of the process.
+// BM_SceneBuild/<preset> reports the scene build time (generation, BVH,
+// indirect light) as its wall time, and its parts as counters.
 
 #include <benchmark/benchmark.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include <time.h>
 
 #include <chrono>
 #include <cmath>
@@ -150,9 +155,15 @@ class BareLoop {
   Eigen::Vector3f light_ = Eigen::Vector3f::UnitZ();
 };
 
-void report(benchmark::State& state, double rays, int threads) {
-  state.counters["rays_per_s_per_core"] =
-      benchmark::Counter(rays / threads, benchmark::Counter::kIsRate);
+/// Process CPU time in seconds (all threads).
+double processCpuS() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+void report(benchmark::State& state, double rays, double cpu_s) {
+  state.counters["rays_per_s_per_core"] = rays / cpu_s;
   state.counters["renders_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()),
                                                        benchmark::Counter::kIsRate);
   state.counters["peak_rss_MB"] = procStatusMb("VmHWM");
@@ -164,8 +175,9 @@ void bareEmbree(benchmark::State& state, std::string preset, int w, int h) {
   const BareLoop loop(s, camera(w, h));
   const evio::Pose T = evio::simulator::previewPose(s.description());
   double rays = 0.0;
+  const double cpu0 = processCpuS();
   for (auto _ : state) rays += static_cast<double>(loop.run(T, threads));
-  report(state, rays, threads);
+  report(state, rays, processCpuS() - cpu0);
 }
 
 void render(benchmark::State& state, std::string preset, int w, int h) {
@@ -176,13 +188,14 @@ void render(benchmark::State& state, std::string preset, int w, int h) {
   const evio::simulator::Renderer renderer(s, camera(w, h), o);
   const evio::Pose T = evio::simulator::previewPose(s.description());
   double rays = 0.0;
+  const double cpu0 = processCpuS();
   for (auto _ : state) {
     evio::simulator::RenderStats stats;
     auto out = renderer.render(T, nullptr, &stats);
     benchmark::DoNotOptimize(out.radiance.data);
     rays += static_cast<double>(stats.camera_rays + stats.shadow_rays);
   }
-  report(state, rays, threads);
+  report(state, rays, processCpuS() - cpu0);
 }
 
 void sceneBuild(benchmark::State& state, std::string preset) {

@@ -55,27 +55,23 @@ inline void sampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, 
   catmullRomWeights(cy - fy, wy, dwy);
   const int n = templ.size();
   const float* base = templ.data() + 2 * ((static_cast<int>(fy) - 1) * n + static_cast<int>(fx) - 1);
-  double f0 = 0.0, f1 = 0.0, fx0 = 0.0, fx1 = 0.0, fy0 = 0.0, fy1 = 0.0;
+  // Both channels (gx, gy) at once as 2-vectors: value, ∂/∂x, ∂/∂y.
+  using A2 = Eigen::Array2d;
+  A2 f = A2::Zero(), fdx = A2::Zero(), fdy = A2::Zero();
   for (int i = 0; i < 4; ++i) {
     const float* row = base + 2 * i * n;
-    double r0 = 0.0, r1 = 0.0, d0 = 0.0, d1 = 0.0;
+    A2 r = A2::Zero(), d = A2::Zero();
     for (int j = 0; j < 4; ++j) {
-      const double v0 = static_cast<double>(row[2 * j]);
-      const double v1 = static_cast<double>(row[2 * j + 1]);
-      r0 += wx[j] * v0;
-      r1 += wx[j] * v1;
-      d0 += dwx[j] * v0;
-      d1 += dwx[j] * v1;
+      const A2 v(static_cast<double>(row[2 * j]), static_cast<double>(row[2 * j + 1]));
+      r += wx[j] * v;
+      d += dwx[j] * v;
     }
-    f0 += wy[i] * r0;
-    f1 += wy[i] * r1;
-    fx0 += wy[i] * d0;
-    fx1 += wy[i] * d1;
-    fy0 += dwy[i] * r0;
-    fy1 += dwy[i] * r1;
+    f += wy[i] * r;
+    fdx += wy[i] * d;
+    fdy += dwy[i] * r;
   }
-  *g = Vec2(f0, f1);
-  if (dg != nullptr) *dg << fx0, fy0, fx1, fy1;
+  *g = Vec2(f[0], f[1]);
+  if (dg != nullptr) *dg << fdx[0], fdy[0], fdx[1], fdy[1];
 }
 
 inline PixelTerm pixelTerm(const GradientTemplate& templ, const WarpFrame& f, double ux, double uy,
@@ -121,7 +117,8 @@ bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, Ekl
   const WarpFrame frame(p);
   const bool inside = warpInside(*batch.templ, frame, P);
   double aa = 0.0, am = 0.0, abs_sum = 0.0;
-  Mat4 D = Mat4::Zero();
+  // Upper triangle of D = Σ ∂a/∂pᵀ ∂a/∂p, accumulated by hand (10 terms).
+  double d00 = 0, d01 = 0, d02 = 0, d03 = 0, d11 = 0, d12 = 0, d13 = 0, d22 = 0, d23 = 0, d33 = 0;
   Vec4 da_a = Vec4::Zero();
   Vec4 da_m = Vec4::Zero();
   for (int i = 0; i < P; ++i) {
@@ -134,7 +131,17 @@ bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, Ekl
       am += t.a * m;
       abs_sum += std::abs(t.a);
       if (with_jacobian) {
-        D.selfadjointView<Eigen::Upper>().rankUpdate(t.da);
+        const double g0 = t.da[0], g1 = t.da[1], g2 = t.da[2], g3 = t.da[3];
+        d00 += g0 * g0;
+        d01 += g0 * g1;
+        d02 += g0 * g2;
+        d03 += g0 * g3;
+        d11 += g1 * g1;
+        d12 += g1 * g2;
+        d13 += g1 * g3;
+        d22 += g2 * g2;
+        d23 += g2 * g3;
+        d33 += g3 * g3;
         da_a += t.a * t.da;
         da_m += m * t.da;
       }
@@ -146,7 +153,11 @@ bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, Ekl
   out->cost = 1.0 - out->rho;  // ½(‖â‖² − 2âᵀm + ‖m‖²) with unit norms
   out->abs_sum = abs_sum;
   if (with_jacobian) {
-    const Mat4 Dfull = D.selfadjointView<Eigen::Upper>();
+    Mat4 Dfull;
+    Dfull << d00, d01, d02, d03,  //
+        d01, d11, d12, d13,       //
+        d02, d12, d22, d23,       //
+        d03, d13, d23, d33;
     const Vec4 s = da_a / n;
     out->jtj = (Dfull - s * s.transpose()) / aa;
     out->jtr = (out->rho * s - da_m) / n;

@@ -58,8 +58,8 @@ TEST(Synchronizer, UpdateTimeMustBeStrictlyAfterThePreviousAndLostTracksLeave) {
   sync.addEvents(10, secondsToNs(0.1));
   MeasurementSet set;
   ASSERT_TRUE(sync.poll(&set));
-  // A point at an older time for a track marks it moved but the latest time
-  // stays 0.10: no update.
+  // A point at the same time replaces the newest point and marks the track
+  // moved, but the latest time stays 0.10: no update.
   sync.addTrackPoints({point(2, 0.10, Vec2(5.5, 5))});
   sync.addEvents(10, secondsToNs(0.1));
   EXPECT_FALSE(sync.poll(&set));

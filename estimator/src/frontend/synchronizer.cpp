@@ -33,9 +33,11 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     auto [it, inserted] = tracks_.try_emplace(p.feature_id);
     if (inserted) order_.push_back(p.feature_id);
     Track& tr = it->second;
-    if (tr.n > 0 && p.t_ns <= tr.t[1]) {  // same or older time: replace the newest point
-      if (p.t_ns == tr.t[1]) tr.uv[1] = p.uv;
-      tr.moved = true;
+    if (tr.n > 0 && p.t_ns <= tr.t[1]) {  // same time: replace the newest point; older: ignore
+      if (p.t_ns == tr.t[1]) {
+        tr.uv[1] = p.uv;
+        tr.moved = true;
+      }
       continue;
     }
     tr.t[0] = tr.t[1];

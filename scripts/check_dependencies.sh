@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Checks the module arrows of DESIGN.md on the sources (the CMake target links
+# enforce them at link time; this catches an include of a system header such as
+# <embree3/...> or <OpenEXR/...> that would compile anyway):
+#   estimator never includes the simulator side, Embree, OpenEXR or GDAL;
+#   core, trajectories, scenes and the simulator never include the estimator;
+#   core includes no other evio module.
+set -u
+cd "$(dirname "$0")/.."
+status=0
+check() {  # check <what> <folders> <regex>
+  local hits
+  hits=$(grep -rnE "$3" $2 --include='*.h' --include='*.cpp' 2>/dev/null || true)
+  if [ -n "$hits" ]; then
+    echo "dependency violation: $1"
+    echo "$hits"
+    status=1
+  fi
+}
+check "estimator includes simulator-side code" "estimator" \
+  '#include *[<"](embree3/|OpenEXR/|Imf|gdal|evio/(simulator|scenes|trajectories|experiments)/|evio/core/io/(exr_file|raster_file|image_file)\.h)'
+check "a lower module includes the estimator or experiments" "core trajectories scenes simulator" \
+  '#include *[<"]evio/(estimator|experiments)/'
+check "core includes another evio module" "core" \
+  '#include *[<"]evio/(trajectories|scenes|simulator)/'
+check "trajectories includes scenes or the simulator" "trajectories" \
+  '#include *[<"]evio/(scenes|simulator)/'
+[ $status -eq 0 ] && echo "dependency arrows respected"
+exit $status

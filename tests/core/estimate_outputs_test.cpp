@@ -1,0 +1,83 @@
+// timing.txt and status.yaml: the estimator's side files read by `evio evaluate`.
+#include <gtest/gtest.h>
+
+#include "evio/core/error.h"
+#include "evio/core/io/atomic_file.h"
+#include "evio/core/io/status_yaml.h"
+#include "evio/core/io/timing_txt.h"
+#include "temp_dir.h"
+
+namespace evio {
+namespace {
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(TimingText, RoundTripsAndStartsWithItsHeader) {
+  std::vector<io::TimingSample> samples;
+  for (int i = 0; i < 50; ++i)
+    samples.push_back({TimeNs{500'000'000} + TimeNs{i} * 100'000'007, 0.013 * i + 0.25, std::int64_t{48'211} * i});
+  test::TempDir dir;
+  io::writeTimingText(dir.file("timing.txt"), samples);
+  EXPECT_EQ(io::readTimingText(dir.file("timing.txt")), samples);
+  EXPECT_EQ(io::readFile(dir.file("timing.txt")).rfind("# t processing_s events\n", 0), 0u);
+}
+
+TEST(TimingText, RejectsBadRowsWithFileLineAndColumn) {
+  test::TempDir dir;
+  const auto read = [&](const std::string& text) {
+    return errorOf([&] {
+      io::writeFileAtomic(dir.file("timing.txt"), text);
+      io::readTimingText(dir.file("timing.txt"));
+    });
+  };
+  EXPECT_EQ(read("0.5 0.01 0\n0.6 0.05 1000\n"), "");
+  EXPECT_NE(read("0.5 0.01 0\n0.5 0.05 10\n").find("timing.txt:2"), std::string::npos);  // t not increasing
+  EXPECT_NE(read("0.5 0.05 0\n0.6 0.01 10\n").find("processing_s"), std::string::npos);   // decreasing
+  EXPECT_NE(read("0.5 0.05 10\n0.6 0.06 9\n").find("events"), std::string::npos);         // decreasing
+  EXPECT_NE(read("0.5 0.05 1.5\n").find("events"), std::string::npos);                    // not whole
+  EXPECT_NE(read("0.5 -1 0\n").find("processing_s"), std::string::npos);
+  EXPECT_NE(read("0.5 0.01\n").find("timing.txt:1"), std::string::npos);  // columns
+  io::TimingWriter w(dir.file("w.txt"));
+  w.append({1000, 0.5, 3});
+  EXPECT_THROW(w.append({1000, 0.6, 3}), Error);
+  EXPECT_THROW(w.append({2000, 0.4, 3}), Error);
+}
+
+TEST(StatusYaml, RoundTripsEveryField) {
+  io::EstimateStatus s;
+  s.code = io::EstimateStatus::Code::kDiverged;
+  s.t_ns = 12'345'000'000;
+  s.cause = "velocity above 100 m/s: \"bad\"";
+  s.initialization_t_ns = 500'000'000;
+  EXPECT_EQ(io::parseStatusYaml(io::formatStatusYaml(s)), s);
+  io::EstimateStatus ok;
+  EXPECT_EQ(io::parseStatusYaml(io::formatStatusYaml(ok)), ok);
+  test::TempDir dir;
+  io::writeStatusYaml(dir.file("status.yaml"), s);
+  EXPECT_EQ(io::readStatusYaml(dir.file("status.yaml")), s);
+}
+
+TEST(StatusYaml, RejectsBadFilesWithLineAndField) {
+  const auto parse = [](const std::string& text) {
+    return errorOf([&] { io::parseStatusYaml(text, "status.yaml"); });
+  };
+  EXPECT_EQ(parse("status: ok\n"), "");
+  EXPECT_EQ(parse("status: failed\ntime_s: 3.5\ncause: no IMU\n"), "");
+  EXPECT_NE(parse("status: diverged\n").find("time_s"), std::string::npos);  // time required
+  EXPECT_NE(parse("status: exploded\ntime_s: 1\n").find("status.yaml:1"), std::string::npos);
+  EXPECT_NE(parse("status: ok\ncolour: red\n").find("status.yaml:2"), std::string::npos);
+  EXPECT_NE(parse("status: ok\nstatus: ok\n").find("duplicate"), std::string::npos);
+  EXPECT_NE(parse("time_s: 1\n").find("status"), std::string::npos);
+  EXPECT_NE(parse("status: failed\ntime_s: .nan\n").find("time_s"), std::string::npos);
+  EXPECT_NE(parse("- a\n").find("status.yaml:1"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace evio

@@ -11,5 +11,6 @@ void addInfoCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
 void addTrackCommand(CLI::App& app);
 void addEvaluateTracksCommand(CLI::App& app);
+void addSimulateCommand(CLI::App& app);
 
 }  // namespace evio::apps

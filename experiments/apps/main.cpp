@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   evio::apps::addTrajectoryCommand(app);
   evio::apps::addTrackCommand(app);
   evio::apps::addEvaluateTracksCommand(app);
+  evio::apps::addSimulateCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

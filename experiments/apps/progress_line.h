@@ -17,6 +17,8 @@ class ProgressLine {
 
   /// `fraction` of the work done (0..1) and the absolute amount processed so far.
   void update(double fraction, double amount);
+  /// Replaces the label (e.g. to show a changing position: "simulate t=1.20/10.00 s").
+  void setLabel(std::string label) { label_ = std::move(label); }
   /// Clears the line (prints a final newline when something was shown).
   void finish();
 

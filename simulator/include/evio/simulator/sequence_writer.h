@@ -1,0 +1,73 @@
+#pragma once
+/// @file sequence_writer.h
+/// The streaming half of a sequence folder, fed by the render loop in time
+/// order with memory flat in the sequence length:
+///   events.h5                 every event (DSEC layout, t_offset = the sequence start)
+///   events.txt                the same as text (optional)
+///   truth/event_labels.bin    one label per event, same order (core/io/event_labels_bin.h)
+///   images.txt, images/       8-bit frames
+///   truth/depth.txt, truth/depth/depth_XXXXXXXX.exr
+///                             event-camera depth (channel Z, m along the optical
+///                             axis, +inf: no surface) at frame stamps; index XXXXXXXX
+///                             = the frame's index in images/; depth.txt lists
+///                             `t depth/depth_XXXXXXXX.exr` like images.txt
+/// Each file appears under its name only when complete (close()).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "evio/core/event.h"
+#include "evio/core/io/event_labels_bin.h"
+#include "evio/core/io/events_h5.h"
+#include "evio/core/io/events_txt.h"
+#include "evio/core/io/images_txt.h"
+#include "evio/simulator/event_camera.h"
+
+namespace evio::simulator {
+
+struct SequenceWriterOptions {
+  int width = 0, height = 0;      ///< event sensor size, px
+  TimeNs t_offset_ns = 0;         ///< events.h5 /t_offset (floored to µs)
+  bool events_txt = true;
+  int events_h5_compression = 0;
+  bool frames = true;
+  bool depth = true;
+};
+
+class SequenceWriter {
+ public:
+  /// Creates `folder` (and truth/, truth/depth/) when missing.
+  SequenceWriter(const std::string& folder, const SequenceWriterOptions& options);
+
+  /// Events (time-sorted, after every earlier one) with one label each.
+  void appendEvents(const EventArray& events, const std::vector<EventLabel>& labels);
+  /// A frame stamped t_ns (CV_8UC1); returns its index.
+  std::size_t appendFrame(TimeNs t_ns, const cv::Mat& image);
+  /// Depth (CV_32FC1) at t_ns, named after frame `index`.
+  void appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth);
+  /// Closes every file; returns the paths written.
+  std::vector<std::string> close();
+
+  std::uint64_t eventCount() const { return events_; }
+  std::uint64_t frameCount() const { return frames_; }
+  std::uint64_t depthCount() const { return depths_; }
+
+ private:
+  std::string folder_;
+  SequenceWriterOptions options_;
+  std::unique_ptr<io::EventH5Writer> h5_;
+  std::unique_ptr<io::EventTextWriter> txt_;
+  std::unique_ptr<io::EventLabelWriter> labels_;
+  std::unique_ptr<io::ImageFolderWriter> images_;
+  std::string depth_list_;
+  std::vector<std::string> files_;
+  std::vector<std::uint8_t> label_bytes_;
+  std::uint64_t events_ = 0, frames_ = 0, depths_ = 0;
+};
+
+}  // namespace evio::simulator

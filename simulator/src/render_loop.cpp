@@ -1,0 +1,226 @@
+#include "render_loop.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <optional>
+
+#include "evio/core/error.h"
+#include "evio/simulator/adaptive_sampler.h"
+#include "evio/simulator/event_camera.h"
+#include "evio/simulator/frame_camera.h"
+#include "evio/simulator/renderer.h"
+
+namespace evio::simulator {
+
+namespace {
+
+constexpr TimeNs kNever = std::numeric_limits<TimeNs>::max();
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// Velocity of a camera C rigidly mounted at T_B_C, in C, from the body's state:
+///   ṗ_W_C = v_W + R_W_B (ω_B × p_B_C),  v_C = R_W_Cᵀ ṗ_W_C,  ω_C = R_B_Cᵀ ω_B.
+CameraVelocity cameraVelocity(const TrajectoryState& s, const Pose& T_B_C) {
+  const Mat3 R_W_B = s.T_W_B.rotation();
+  const Mat3 R_B_C = T_B_C.rotation();
+  const Vec3 p_dot_W = s.v_W + R_W_B * s.omega_B.cross(T_B_C.translation());
+  CameraVelocity v;
+  v.v_C = (R_W_B * R_B_C).transpose() * p_dot_W;
+  v.omega_C = R_B_C.transpose() * s.omega_B;
+  return v;
+}
+
+/// The next render interval: λ C over the q-quantile of the predicted
+/// per-pixel |dL/dt|, within the sampler's rate bounds.
+class StepPredictor {
+ public:
+  StepPredictor(const RenderScheduleOptions& o, const EventCamera::Options& ec)
+      : sampler_(samplerOptions(o), std::min(ec.threshold_pos, ec.threshold_neg), ec.log_eps_w_m2_sr),
+        quantile_(o.fastest_pixel_quantile) {}
+
+  TimeNs interval(const cv::Mat& radiance, const cv::Mat& flow) {
+    const cv::Mat l = sampler_.logImage(radiance);
+    rates_.clear();
+    rates_.reserve(static_cast<std::size_t>(l.rows) * static_cast<std::size_t>(l.cols));
+    for (int y = 0; y < l.rows; ++y)
+      for (int x = 0; x < l.cols; ++x) rates_.push_back(sampler_.logRateAt(l, flow, x, y));
+    if (rates_.empty()) return sampler_.interval(0.0f);
+    float rate = 0.0f;
+    if (quantile_ >= 1.0) {
+      rate = *std::max_element(rates_.begin(), rates_.end());
+    } else {
+      const auto k = static_cast<std::ptrdiff_t>(quantile_ * static_cast<double>(rates_.size() - 1));
+      std::nth_element(rates_.begin(), rates_.begin() + k, rates_.end());
+      rate = rates_[static_cast<std::size_t>(k)];
+    }
+    return sampler_.interval(rate);
+  }
+
+ private:
+  static AdaptiveSampler::Options samplerOptions(const RenderScheduleOptions& o) {
+    AdaptiveSampler::Options s;
+    s.lambda = o.lambda;
+    s.min_rate_hz = o.min_rate_hz;
+    s.max_rate_hz = o.max_rate_hz;
+    s.rate_bound = o.rate_bound;
+    return s;
+  }
+  AdaptiveSampler sampler_;
+  double quantile_;
+  std::vector<float> rates_;
+};
+
+/// The exposure of one frame: its sub-sample times and the images so far.
+struct FrameInProgress {
+  std::size_t index = 0;
+  TimeNs start_ns = 0;
+  TimeNs stamp_ns = 0;             ///< mid-exposure, as FrameCamera::capture stamps it
+  std::vector<TimeNs> sample_ns;   ///< N times, both ends of the exposure included
+  std::vector<cv::Mat> images;
+  bool depth_done = false;
+  TimeNs next() const { return sample_ns[images.size()]; }
+};
+
+}  // namespace
+
+RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& scene, SequenceWriter& writer,
+                               const ProgressCallback& progress, SimulationStats* stats) {
+  const ScenarioOptions& o = scenario.options;
+  const auto& fo = o.rig.frame_camera;
+  const ContinuousTrajectory& trajectory = *scenario.trajectory;
+  const Camera event_cam = scenario.eventCamera();
+  const Pose T_B_E = scenario.T_B_E();
+
+  RendererOptions ro;
+  ro.threads = o.threads;
+  ro.supersampling = o.sampling.supersampling;
+  const Renderer renderer(scene, event_cam, ro);
+  std::optional<Renderer> frame_renderer;
+  const bool frames = fo.enabled;
+  const bool separate = frames && !fo.co_located;
+  const Pose T_B_F = frames ? scenario.T_B_F() : Pose();
+  if (separate) frame_renderer.emplace(scene, scenario.frameCamera(), ro);
+
+  EventCamera::Options eo = o.rig.event_camera.sensor.event_camera;
+  eo.threads = o.threads;
+  EventCamera events_cam(event_cam.width(), event_cam.height(), eo, o.seed);
+  StepPredictor predictor(o.sampling, eo);
+  std::optional<FrameCamera> frame_cam;
+  if (frames) {
+    FrameCamera::Options fco = fo.sensor;
+    fco.threads = o.threads;
+    const Camera c = scenario.frameCamera();
+    frame_cam.emplace(c.width(), c.height(), fco, o.seed);
+  }
+  const bool depth_on = frames && o.output.depth_at_frames;
+
+  // Frame k's exposure starts at start + round(k / rate_hz); the frame is
+  // taken only when its whole exposure lies inside the window.
+  std::size_t frame_k = 0;
+  bool frames_done = !frames;
+  std::optional<FrameInProgress> frame;
+  const auto beginFrame = [&] {
+    const TimeNs start = scenario.start_ns + static_cast<TimeNs>(std::llround(static_cast<double>(frame_k) * 1e9 / fo.rate_hz));
+    const double exposure = frame_cam->exposureS();
+    const TimeNs exposure_ns = secondsToNs(exposure);
+    if (start + exposure_ns > scenario.end_ns) {
+      frames_done = true;
+      return;
+    }
+    FrameInProgress f;
+    f.index = frame_k;
+    f.start_ns = start;
+    f.stamp_ns = start + secondsToNs(0.5 * exposure);
+    const int n = fo.exposure_samples;
+    for (int j = 0; j < n; ++j) {
+      // The middle sample of an odd N is exactly the stamp (one render serves both).
+      const TimeNs t = n == 1 ? start
+                       : 2 * j == n - 1 ? f.stamp_ns
+                                        : start + secondsToNs(exposure * static_cast<double>(j) / (n - 1));
+      if (f.sample_ns.empty() || t > f.sample_ns.back()) f.sample_ns.push_back(t);
+    }
+    frame = std::move(f);
+  };
+  const auto addSample = [&](const cv::Mat& radiance) {
+    frame->images.push_back(radiance);
+    if (frame->images.size() < frame->sample_ns.size()) return;
+    auto t0 = Clock::now();
+    const Frame captured = frame_cam->capture(frame->start_ns, frame->images);
+    stats->frame_s += secondsSince(t0);
+    t0 = Clock::now();
+    writer.appendFrame(captured.t_ns, captured.image);
+    stats->write_s += secondsSince(t0);
+    frame.reset();
+    ++frame_k;
+  };
+
+  RenderLoopResult result;
+  EventArray batch;
+  std::vector<EventLabel> labels;
+  TimeNs next_event = scenario.start_ns;
+  TimeNs last_t = kNever;
+  RenderOutput last;
+  const double total_s = nsToSeconds(scenario.end_ns - scenario.start_ns);
+  while (true) {
+    if (!frames_done && !frame) beginFrame();
+    const TimeNs t_frame = frame ? frame->next() : kNever;
+    const TimeNs t_depth = frame && depth_on && !frame->depth_done ? frame->stamp_ns : kNever;
+    const TimeNs t = std::min({next_event, scenario.end_ns, t_depth, separate ? kNever : t_frame});
+
+    if (separate && t_frame <= t) {  // a separate frame camera's own sub-sample
+      const Pose T_W_F = trajectory.evaluate(t_frame).T_W_B * T_B_F;
+      const auto t0 = Clock::now();
+      RenderOutput out = frame_renderer->render(T_W_F);
+      stats->frame_render_s += secondsSince(t0);
+      ++stats->frame_renders;
+      addSample(out.radiance);
+      continue;
+    }
+
+    if (t != last_t) {
+      const TrajectoryState state = trajectory.evaluate(t);
+      const Pose T_W_E = state.T_W_B * T_B_E;
+      const CameraVelocity velocity = cameraVelocity(state, T_B_E);
+      auto t0 = Clock::now();
+      last = renderer.render(T_W_E, &velocity);
+      stats->render_s += secondsSince(t0);
+      ++stats->renders;
+
+      t0 = Clock::now();
+      batch.clear();
+      labels.clear();
+      events_cam.update(t, last.radiance, &batch, &labels);
+      stats->event_s += secondsSince(t0);
+
+      t0 = Clock::now();
+      writer.appendEvents(batch, labels);
+      stats->write_s += secondsSince(t0);
+      if (last_t == kNever) {
+        result.first_depth = last.depth.clone();
+        result.first_T_W_E = T_W_E;
+      }
+      last_t = t;
+      if (t < scenario.end_ns) {  // the next step, predicted from this (latest) sample
+        t0 = Clock::now();
+        next_event = t + predictor.interval(last.radiance, last.flow);
+        stats->schedule_s += secondsSince(t0);
+      }
+    }
+    if (!separate && frame && t == t_frame) addSample(last.radiance);
+    if (frame && t == t_depth) {
+      const auto t0 = Clock::now();
+      writer.appendDepth(frame->index, t, last.depth);
+      stats->write_s += secondsSince(t0);
+      frame->depth_done = true;
+    }
+    if (progress)
+      progress(SimulationProgress{nsToSeconds(t - scenario.start_ns), total_s, writer.eventCount(), stats->renders});
+    if (t >= scenario.end_ns) break;
+  }
+  stats->pixel_updates = events_cam.pixelUpdates();
+  return result;
+}
+
+}  // namespace evio::simulator

@@ -1,0 +1,81 @@
+#include "evio/simulator/sequence_writer.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "evio/core/error.h"
+#include "evio/core/io/atomic_file.h"
+#include "evio/core/io/exr_file.h"
+#include "evio/core/io/text_scanner.h"
+
+namespace evio::simulator {
+
+namespace fs = std::filesystem;
+
+SequenceWriter::SequenceWriter(const std::string& folder, const SequenceWriterOptions& options)
+    : folder_(folder), options_(options) {
+  std::error_code ec;
+  fs::create_directories(fs::path(folder_) / "truth", ec);
+  if (!ec && options_.depth) fs::create_directories(fs::path(folder_) / "truth" / "depth", ec);
+  if (ec) throw Error(folder_ + ": cannot create the output folder: " + ec.message());
+  io::EventH5Options h5;
+  h5.width = options_.width;
+  h5.height = options_.height;
+  h5.compression_level = options_.events_h5_compression;
+  h5_ = std::make_unique<io::EventH5Writer>((fs::path(folder_) / "events.h5").string(), h5, options_.t_offset_ns);
+  if (options_.events_txt) txt_ = std::make_unique<io::EventTextWriter>((fs::path(folder_) / "events.txt").string());
+  labels_ = std::make_unique<io::EventLabelWriter>((fs::path(folder_) / "truth" / "event_labels.bin").string());
+  if (options_.frames) images_ = std::make_unique<io::ImageFolderWriter>(folder_);
+}
+
+void SequenceWriter::appendEvents(const EventArray& events, const std::vector<EventLabel>& labels) {
+  require(labels.size() == events.size(), "SequenceWriter: one label per event");
+  if (events.empty()) return;
+  h5_->append(events);
+  if (txt_) txt_->append(events);
+  label_bytes_.resize(labels.size());
+  for (std::size_t i = 0; i < labels.size(); ++i) label_bytes_[i] = static_cast<std::uint8_t>(labels[i]);
+  labels_->append(label_bytes_.data(), label_bytes_.size());
+  events_ += events.size();
+}
+
+std::size_t SequenceWriter::appendFrame(TimeNs t_ns, const cv::Mat& image) {
+  require(images_ != nullptr, "SequenceWriter: frames are off");
+  images_->append(t_ns, image);
+  return static_cast<std::size_t>(frames_++);
+}
+
+void SequenceWriter::appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth) {
+  char name[40];
+  std::snprintf(name, sizeof(name), "depth/depth_%08zu.exr", index);
+  io::writeExr((fs::path(folder_) / "truth" / name).string(), {{"Z", depth}});
+  io::appendSeconds(depth_list_, t_ns);
+  depth_list_ += ' ';
+  depth_list_ += name;
+  depth_list_ += '\n';
+  ++depths_;
+}
+
+std::vector<std::string> SequenceWriter::close() {
+  h5_->close();
+  files_.push_back(h5_->path());
+  if (txt_) {
+    txt_->close();
+    files_.push_back((fs::path(folder_) / "events.txt").string());
+  }
+  labels_->close();
+  files_.push_back((fs::path(folder_) / "truth" / "event_labels.bin").string());
+  if (images_) {
+    images_->close();
+    files_.push_back((fs::path(folder_) / "images.txt").string());
+  }
+  if (options_.depth) {
+    const std::string list = (fs::path(folder_) / "truth" / "depth.txt").string();
+    io::writeFileAtomic(list, "# t depth/depth_XXXXXXXX.exr: event-camera depth (channel Z, m) at frame stamps\n" +
+                                  depth_list_);
+    files_.push_back(list);
+  }
+  return files_;
+}
+
+}  // namespace evio::simulator

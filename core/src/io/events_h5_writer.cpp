@@ -76,6 +76,8 @@ struct EventH5Writer::Impl {
     if (opt.checksum)
       h5::checkStatus(H5Pset_fletcher32(dcpl.get()), path, name, "checksum filter unavailable");
     h5::checkStatus(H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER), path, name, "fill time");
+    // No modification times in object headers: same events => byte-identical file.
+    h5::checkStatus(H5Pset_obj_track_times(dcpl.get(), false), path, name, "track times");
     return h5::dataset(h5::check(H5Dcreate2(file.get(), name, file_type, space.get(), H5P_DEFAULT,
                                             dcpl.get(), H5P_DEFAULT),
                                  path, name, "cannot create dataset"));
@@ -259,8 +261,10 @@ struct EventH5Writer::Impl {
 
     h5::Handle space =
         h5::dataspace(h5::check(H5Screate(H5S_SCALAR), path, "/t_offset", "dataspace"));
+    h5::Handle dcpl = h5::plist(h5::check(H5Pcreate(H5P_DATASET_CREATE), path, "/t_offset", "plist"));
+    h5::checkStatus(H5Pset_obj_track_times(dcpl.get(), false), path, "/t_offset", "track times");
     h5::Handle ds = h5::dataset(h5::check(H5Dcreate2(file.get(), "/t_offset", H5T_STD_I64LE,
-                                                     space.get(), H5P_DEFAULT, H5P_DEFAULT,
+                                                     space.get(), H5P_DEFAULT, dcpl.get(),
                                                      H5P_DEFAULT),
                                           path, "/t_offset", "cannot create dataset"));
     h5::checkStatus(
@@ -310,8 +314,10 @@ EventH5Writer::EventH5Writer(std::string path, const EventH5Options& options,
   try {
     w.file = h5::file(h5::check(H5Fcreate(w.tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
                                 w.path, "", "cannot create file"));
+    h5::Handle gcpl = h5::plist(h5::check(H5Pcreate(H5P_GROUP_CREATE), w.path, "/events", "plist"));
+    h5::checkStatus(H5Pset_obj_track_times(gcpl.get(), false), w.path, "/events", "track times");
     h5::Handle g = h5::group(h5::check(
-        H5Gcreate2(w.file.get(), "/events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), w.path,
+        H5Gcreate2(w.file.get(), "/events", H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), w.path,
         "/events", "cannot create group"));
     w.t = w.create("/events/t", w.wide ? H5T_STD_I64LE : H5T_STD_U32LE, options.chunk_events);
     w.x = w.create("/events/x", H5T_STD_U16LE, options.chunk_events);

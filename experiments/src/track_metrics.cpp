@@ -89,11 +89,14 @@ TrackMetrics evaluateTracks(const std::vector<io::TrackSample>& estimated, const
     }
     if (match == nullptr) continue;
     ++m.matched_tracks;
+    // "nearest": the estimated start is taken as exact and the ground-truth
+    // track's displacement since then as the true motion.
+    const Vec2 offset = options.match == "nearest" ? Vec2(first.uv - *at(*match, first.t_ns, max_gap_ns)) : Vec2::Zero();
     double age = 0.0;
     for (const auto& s : track) {
       const auto p = at(*match, s.t_ns, max_gap_ns);
       if (!p) break;  // ground truth ends (occluded or out of view)
-      const double err = (s.uv - *p).norm();
+      const double err = (s.uv - (*p + offset)).norm();
       if (err > options.max_error_px) break;
       age = nsToSeconds(s.t_ns - first.t_ns);
       errors.push_back(err);

@@ -18,8 +18,9 @@ TEST(TrackMetrics, ErrorAgeAndAliveAreExact) {
   std::vector<TrackSample> truth, est;
   addLine(truth, 100, 0.0, 1.0, Vec2(10, 10), Vec2(20, 0));
   addLine(truth, 200, 0.0, 1.0, Vec2(50, 50), Vec2(0, 10));
-  // Track 1 follows 100 with a constant 0.5 px offset in y, sampled at odd times.
-  for (double t = 0.0; t <= 0.6 + 1e-9; t += 0.015) est.push_back({1, secondsToNs(t), Vec2(10 + 20 * t, 10.5)});
+  // Track 1 starts 0.5 px below 100 and drifts down at 1 px/s, sampled at odd
+  // times: its error (the start offset is not counted) is t − 0 px.
+  for (double t = 0.0; t <= 0.6 + 1e-9; t += 0.015) est.push_back({1, secondsToNs(t), Vec2(10 + 20 * t, 10.5 + t)});
   // Track 2 starts on 200, its error grows 10 px/s: passes 5 px at 0.5 s.
   for (double t = 0.2; t <= 0.9 + 1e-9; t += 0.1)
     est.push_back({2, secondsToNs(t), Vec2(50 + 10 * (t - 0.2), 50 + 10 * t)});
@@ -33,17 +34,18 @@ TEST(TrackMetrics, ErrorAgeAndAliveAreExact) {
   const TrackMetrics m = evaluateTracks(est, truth, o);
   EXPECT_EQ(m.estimated_tracks, 3u);
   EXPECT_EQ(m.matched_tracks, 2u);
-  // Track 1: 41 samples at 0.5 px; track 2: errors 0, 1, 2, 3 px (ages 0…0.3);
-  // at age 0.4 (t = 0.6) the error is 4 px, at 0.5 it is 5 px (≤ 5 still counts),
-  // at 0.6 it is 6 px: the track's scored life ends at age 0.5.
+  // Track 1: 41 samples with error t (sum 0.015 · (0 + 1 + … + 40) = 12.3);
+  // track 2: errors 0, 1, 2, 3 px (ages 0…0.3); at age 0.4 (t = 0.6) 4 px,
+  // at 0.5 5 px (≤ 5 still counts), at 0.6 6 px: its scored life ends at 0.5.
   EXPECT_EQ(m.scored_samples, 41u + 6u);
-  EXPECT_NEAR(m.mean_error_px, (41 * 0.5 + 0 + 1 + 2 + 3 + 4 + 5) / 47.0, 1e-9);
+  EXPECT_NEAR(m.mean_error_px, (12.3 + 0 + 1 + 2 + 3 + 4 + 5) / 47.0, 1e-9);
   EXPECT_NEAR(m.mean_feature_age_s, 0.5 * (0.6 + 0.5), 1e-9);
   ASSERT_GE(m.error_vs_age.size(), 6u);
   EXPECT_NEAR(m.error_vs_age[0].age_s, 0.0, 1e-12);
-  // Age bin [0, 0.1): track 1 ages 0…0.09 (7 samples) plus track 2 at age 0.
+  // Age bin [0, 0.1): track 1 ages 0…0.09 (7 samples, errors 0.015 k) plus
+  // track 2 at age 0.
   EXPECT_EQ(m.error_vs_age[0].samples, 8u);
-  EXPECT_NEAR(m.error_vs_age[0].mean_error_px, 7 * 0.5 / 8.0, 1e-9);
+  EXPECT_NEAR(m.error_vs_age[0].mean_error_px, 0.015 * (0 + 1 + 2 + 3 + 4 + 5 + 6) / 8.0, 1e-9);
   // Alive at 0, 0.5, 1.0 s: estimated 1 (track 1), 2 (tracks 1, 2), 0; truth 2 each.
   ASSERT_EQ(m.alive.size(), 3u);
   EXPECT_EQ(m.alive[0].estimated, 1u);

@@ -11,7 +11,9 @@
 /// id (match "id", for ground truth generated from the estimated tracks'
 /// first points) or by the ground-truth track nearest to the estimated
 /// track's first point at its first time, within association_radius_px
-/// (match "nearest"). Ground truth is interpolated linearly in time between
+/// (match "nearest"; the estimated start is then taken as exact and the
+/// ground-truth track's displacement since that time as the true motion, so
+/// the start offset is not counted as error). Ground truth is interpolated linearly in time between
 /// its samples; gaps longer than max_gap_s (occlusion) are not bridged, and
 /// an estimated track is scored only while the ground truth covers it.
 

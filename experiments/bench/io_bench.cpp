@@ -27,6 +27,7 @@
 
 #include "evio/core/event.h"
 #include "evio/core/io/events_h5.h"
+#include "evio/core/io/events_txt.h"
 #include "evio/core/random_stream.h"
 
 namespace {
@@ -294,6 +295,65 @@ BENCHMARK(BM_EventsH5ReadWindow)
     ->Args({1, 16, 1})
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
+
+// ---------------------------------------------------------------------------
+// events.txt (Event-Camera Dataset text)
+// ---------------------------------------------------------------------------
+
+/// Events in the text benchmarks: 2^22 = 4.2 M (a 90 MB file).
+constexpr std::size_t kTextEvents = std::size_t{1} << 22;
+
+/// A events.txt of kTextEvents generator events, made once.
+const std::string& textFile() {
+  static const std::string path = [] {
+    const std::string p = (scratchDir() / "events.txt").string();
+    EventGenerator gen(4);
+    evio::io::EventTextWriter writer(p);
+    evio::EventArray block;
+    for (std::size_t done = 0; done < kTextEvents; done += block.size()) {
+      gen.next(block, std::min<std::size_t>(1 << 16, kTextEvents - done));
+      writer.append(block);
+    }
+    writer.close();
+    return p;
+  }();
+  return path;
+}
+
+/// Streaming read with full validation (columns, numbers, time order,
+/// pixels inside the 640x480 sensor), in batches of 2^16 events.
+void BM_EventsTxtReadStream(benchmark::State& state) {
+  const std::string& path = textFile();
+  evio::EventArray out;
+  MemoryCounters memory(state);
+  for (auto _ : state) {
+    evio::io::EventTextReader reader(path, evio::io::SensorSize{kSensorWidth, kSensorHeight});
+    std::size_t n = 0;
+    while (true) {
+      out.clear();
+      if (!reader.next(out, std::size_t{1} << 16)) break;
+      n += out.size();
+    }
+    if (n != kTextEvents) state.SkipWithError("wrong event count");
+    benchmark::DoNotOptimize(out.t().data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kTextEvents));
+  state.counters["bytes_per_event"] =
+      static_cast<double>(std::filesystem::file_size(path)) / static_cast<double>(kTextEvents);
+}
+
+void BM_EventsTxtWrite(benchmark::State& state) {
+  EventGenerator gen(5);
+  evio::EventArray events;
+  gen.next(events, kTextEvents);
+  const std::string path = (scratchDir() / "write.txt").string();
+  MemoryCounters memory(state);
+  for (auto _ : state) evio::io::writeEventsText(path, events);
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kTextEvents));
+}
+
+BENCHMARK(BM_EventsTxtReadStream)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EventsTxtWrite)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

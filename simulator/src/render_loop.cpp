@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <optional>
 
@@ -72,6 +73,24 @@ class StepPredictor {
   std::vector<float> rates_;
 };
 
+/// t = target^γ · full_well / (K · mean radiance) within the exposure limits:
+/// the exposure whose noise-free mean DN / 255 is the target (linear until
+/// saturation), NaN and negative radiance counting as 0.
+double meteredExposure(const cv::Mat& radiance, const FrameCamera::Options& o, const FrameCamera& camera) {
+  double sum = 0.0;
+  for (int y = 0; y < radiance.rows; ++y) {
+    const float* r = radiance.ptr<float>(y);
+    for (int x = 0; x < radiance.cols; ++x) sum += r[x] > 0.0f ? static_cast<double>(r[x]) : 0.0;
+  }
+  const double mean = sum / (static_cast<double>(radiance.rows) * static_cast<double>(radiance.cols));
+  const double lo = o.auto_exposure ? o.auto_exposure_min_s : 1e-6;
+  const double hi = o.auto_exposure ? o.auto_exposure_max_s : o.exposure_s;
+  if (!(mean > 0.0)) return hi;
+  const double t = std::pow(o.auto_exposure_target, o.gamma) * o.full_well_e /
+                   (camera.electronsPerRadianceSecond() * mean);
+  return std::clamp(t, lo, hi);
+}
+
 /// The exposure of one frame: its sub-sample times and the images so far.
 struct FrameInProgress {
   std::size_t index = 0;
@@ -112,6 +131,14 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
     FrameCamera::Options fco = fo.sensor;
     fco.threads = o.threads;
     const Camera c = scenario.frameCamera();
+    if (fo.meter_first_exposure) {
+      const Pose T_W_F = trajectory.evaluate(scenario.start_ns).T_W_B * T_B_F;
+      const auto t0 = Clock::now();
+      const RenderOutput view = (separate ? *frame_renderer : renderer).render(T_W_F);
+      stats->frame_render_s += secondsSince(t0);
+      ++stats->frame_renders;
+      fco.exposure_s = meteredExposure(view.radiance, fco, FrameCamera(c.width(), c.height(), fco, o.seed));
+    }
     frame_cam.emplace(c.width(), c.height(), fco, o.seed);
   }
   const bool depth_on = frames && o.output.depth_at_frames;

@@ -76,6 +76,11 @@ struct FrameCameraRigOptions {
   bool co_located = true;             ///< frames from the event pixels (same camera, pose and renders)
   double rate_hz = 20.0;              ///< frame rate: exposure k starts at start + k / rate_hz
   int exposure_samples = 3;           ///< N renders evenly over the exposure, both ends (motion blur)
+  /// Meter the first exposure on a render of the first view: the exposure
+  /// whose noise-free mean DN/255 is the auto-exposure target,
+  /// t = (target^γ · full_well) / (K · mean radiance), within the exposure
+  /// limits (frame_camera.h); otherwise start at sensor.exposure_s.
+  bool meter_first_exposure = true;
   std::string name = "frames";        ///< camera name in sensors.yaml
   // A separate camera only (co_located = false):
   std::string model = "pinhole";      ///< pinhole, radtan or equidistant
@@ -92,6 +97,7 @@ struct FrameCameraRigOptions {
     v("co_located", co_located, "frames from the event camera's pixels (DAVIS APS)");
     v("rate_hz", rate_hz, "frame rate, Hz");
     v("exposure_samples", exposure_samples, "renders over each exposure (motion blur)");
+    v("meter_first_exposure", meter_first_exposure, "set the first exposure from a render of the first view");
     v("name", name, "camera name in sensors.yaml");
     v("model", model, "separate camera: lens model");
     v("width", width, "separate camera: width, px");

@@ -11,6 +11,8 @@ void addInfoCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
 void addTrackCommand(CLI::App& app);
 void addEvaluateTracksCommand(CLI::App& app);
+void addEvaluateCommand(CLI::App& app);
+void addCampaignCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 
 }  // namespace evio::apps

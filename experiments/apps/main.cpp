@@ -14,6 +14,8 @@ int main(int argc, char** argv) {
   evio::apps::addTrajectoryCommand(app);
   evio::apps::addTrackCommand(app);
   evio::apps::addEvaluateTracksCommand(app);
+  evio::apps::addEvaluateCommand(app);
+  evio::apps::addCampaignCommand(app);
   evio::apps::addSimulateCommand(app);
   try {
     app.parse(argc, argv);

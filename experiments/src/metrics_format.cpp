@@ -119,7 +119,7 @@ JsonValue metricsJson(const Metrics& m, const EvaluationOptions& options, const 
   JsonValue& n = j.set("nees", JsonValue::object());
   n.set("available", JsonValue::boolean(m.nees.available));
   if (m.nees.available) {
-    n.set("alignment", JsonValue::string(tag));
+    n.set("alignment", JsonValue::string(options.nees.use_alignment ? tag : "none (nees.use_alignment false)"));
     n.set("rotation_error", JsonValue::string(options.nees.rotation_error));
     n.set("poses", JsonValue::integer(static_cast<std::int64_t>(m.nees.poses)));
     n.set("singular", JsonValue::integer(static_cast<std::int64_t>(m.nees.singular)));

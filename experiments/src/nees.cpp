@@ -39,7 +39,7 @@ NeesMetrics poseNees(const Association& association, const Alignment& alignment,
     const auto it = std::lower_bound(covariance.begin(), covariance.end(), a.t_ns,
                                      [](const io::StampedPoseCovariance& c, TimeNs t) { return c.t_ns < t; });
     if (it == covariance.end() || it->t_ns != a.t_ns) continue;
-    const Pose gt = alignment.transform.applyInverse(a.T_W_gt);
+    const Pose gt = options.use_alignment ? alignment.transform.applyInverse(a.T_W_gt) : a.T_W_gt;
     const Vec3 e_p = gt.translation() - a.T_W_es.translation();
     const Mat3 R_es = a.T_W_es.rotation();
     const Vec3 e_r = local ? so3::log(Mat3(R_es.transpose() * gt.rotation()))

@@ -137,6 +137,11 @@ TEST(TrajectoryMetrics, NeesOfSamplesDrawnFromTheStatedCovarianceMatchesItsDimen
   EXPECT_NEAR(m.nees.mean_position, 3.0, 4.0 * std::sqrt(6.0 / 20001.0));
   EXPECT_NEAR(m.nees.mean_orientation, 3.0, 4.0 * std::sqrt(6.0 / 20001.0));
   EXPECT_NEAR(m.nees.share_in_bounds, 0.95, 4.0 * std::sqrt(0.95 * 0.05 / 20001.0));
+  // NEES in the estimate's own frame ignores the (here posyaw, window) alignment.
+  EvaluationOptions own_frame;
+  own_frame.alignment = AlignmentOptions::paper();
+  own_frame.nees.use_alignment = false;
+  EXPECT_DOUBLE_EQ(evaluateTrajectory(in, own_frame).nees.mean_pose, m.nees.mean_pose);
   // Covariances 4× too large: NEES falls to a quarter.
   for (auto& c : in.covariance) {
     c.cov_position *= 4.0;

@@ -8,7 +8,8 @@
 ///
 /// The ground truth is mapped into the estimate's frame by the inverse of the
 /// evaluation's alignment S (so the estimate and its covariance stay as the
-/// estimator wrote them): T̃_gt = S⁻¹(T_gt). Then
+/// estimator wrote them): T̃_gt = S⁻¹(T_gt) (with use_alignment; else
+/// T̃_gt = T_gt). Then
 ///   e_p = p̃_gt − p̂                                   (m)
 ///   e_θ = Log(R̂ᵀ R̃_gt)   rotation_error "local":  R_true = R̂·Exp(δθ), δθ in X
 ///   e_θ = Log(R̃_gt R̂ᵀ)   rotation_error "global": R_true = Exp(δθ)·R̂, δθ in W
@@ -31,10 +32,15 @@ namespace evio::experiments {
 
 struct NeesOptions {
   std::string rotation_error = "local";  ///< local | global (see above)
+  /// Map the ground truth by the evaluation's alignment first (true), or
+  /// compare in the estimate's own frame (false: for simulation runs started
+  /// at the true pose, where a window alignment only adds its own error).
+  bool use_alignment = true;
 
   template <class V>
   void fields(V& v) {
     v("rotation_error", rotation_error, "convention of the orientation covariance: local or global");
+    v("use_alignment", use_alignment, "map the ground truth by the evaluation's alignment first");
   }
   void validate() const;
 };

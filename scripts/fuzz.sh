@@ -7,16 +7,21 @@ cd "$(dirname "$0")/.."
 seconds=${1:-180}
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is required (apt-get install clang)"; exit 1; }
 cmake --preset fuzz >/dev/null
-targets=(fuzz_events_txt fuzz_imu_txt fuzz_tum fuzz_images_txt fuzz_config_yaml)
+names=(events_txt imu_txt tum images_txt config_yaml calib_txt sensors_yaml tracks_txt range_txt imu_state_txt)
+targets=("${names[@]/#/fuzz_}")
 cmake --build --preset fuzz -j "$(nproc)" --target "${targets[@]}"
 corpus=build/fuzz/corpus
-mkdir -p "$corpus"/{events_txt,imu_txt,tum,images_txt,config_yaml}
+for name in "${names[@]}"; do mkdir -p "$corpus/$name"; done
 printf '0.000000000 1 2 1\n0.000001000 239 179 0\n' > "$corpus/events_txt/seed"
 printf '0.0 0 0 9.81 0 0 0\n0.005 0.1 -0.2 9.8 0.01 0 0\n' > "$corpus/imu_txt/seed"
 printf '# t tx ty tz qx qy qz qw\n0.0 0 0 0 0 0 0 1\n0.1 1 2 3 0 0 0.7071068 0.7071068\n' > "$corpus/tum/seed"
 printf '0.0 images/frame_00000000.png\n' > "$corpus/images_txt/seed"
 printf 'exposure_s: 0.02\ninner:\n  count: 5\noffset_m: [1, 2, 3]\nweights: [1, 2]\n' > "$corpus/config_yaml/seed"
-for name in events_txt imu_txt tum images_txt config_yaml; do
+printf '200.0 200.0 120.0 90.0 -0.37 0.16 0.0 0.0 0.0\n' > "$corpus/calib_txt/seed"
+printf '0 0.000 10.5 20.25\n0 0.005 10.6 20.3\n1 0.005 50 60\n' > "$corpus/tracks_txt/seed"
+printf '0.0 1.5 1\n0.1 0 0\n' > "$corpus/range_txt/seed"
+cp tests/fuzz/seeds/sensors.yaml "$corpus/sensors_yaml/seed" 2>/dev/null || true
+for name in "${names[@]}"; do
   echo "== fuzz_$name for ${seconds}s"
   build/fuzz/tests/fuzz/fuzz_$name -max_total_time="$seconds" -print_final_stats=1 "$corpus/$name" 2>&1 \
     | grep -E "stat::number_of_executed_units|ERROR|SUMMARY|Done" || true

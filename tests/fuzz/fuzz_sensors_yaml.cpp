@@ -1,0 +1,13 @@
+// libFuzzer target: sensors.yaml reader (evio::Error or success, nothing else).
+#include "evio/core/error.h"
+#include "evio/core/io/sensors_yaml.h"
+#include "fuzz_input_file.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string path = evio::fuzz::writeInput(data, size, "sensors.yaml");
+  try {
+    (void)evio::io::readSensorsYaml(path);
+  } catch (const evio::Error&) {
+  }
+  return 0;
+}

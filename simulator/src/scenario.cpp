@@ -25,11 +25,11 @@ std::string resolvePath(const std::string& relative, const std::string& base_dir
                         const std::string& where) {
   const fs::path p(relative);
   if (p.is_absolute()) {
-    if (fs::exists(p)) return p.string();
+    if (fs::is_regular_file(p)) return p.string();
   } else {
     const fs::path first = base_dir.empty() ? p : fs::path(base_dir) / p;
-    if (fs::exists(first)) return first.lexically_normal().string();
-    if (!search_root.empty() && fs::exists(fs::path(search_root) / p))
+    if (fs::is_regular_file(first)) return first.lexically_normal().string();
+    if (!search_root.empty() && fs::is_regular_file(fs::path(search_root) / p))
       return (fs::path(search_root) / p).lexically_normal().string();
   }
   throw Error(where + ": file not found: '" + relative + "' (tried relative to '" +
@@ -45,7 +45,7 @@ void mergeInto(YAML::Node base, const YAML::Node& overlay) {
     if (b.IsDefined() && b.IsMap() && it->second.IsMap())
       mergeInto(b, it->second);
     else
-      base[key] = YAML::Clone(it->second);
+      base[key] = it->second;  // shared, keeps its line numbers for messages
   }
 }
 
@@ -85,7 +85,7 @@ config::Document sectionDocument(const config::Document& doc, const YAML::Node& 
   config::Document out;
   out.overridden = overriddenBelow(doc, section);
   if (preset_path.empty()) {
-    out.root = YAML::Clone(overlay);
+    out.root = overlay;  // the scenario's own nodes: messages keep their lines
     out.file = doc.file;
     *dir = base_dir;
     return out;
@@ -128,27 +128,28 @@ Scenario loadScenarioDocument(config::Document doc, const std::string& base_dir,
   if (cam_node.IsDefined() && !cam_node.IsNull()) {
     if (!cam_node.IsMap()) config::detail::throwAt(doc, cam_node, "rig.event_camera", "expected a map");
     const YAML::Node preset = cam_node["preset"];
-    if (preset.IsDefined() && !preset.IsNull()) {
+    if (preset.IsDefined() && !preset.IsNull() && !(preset.IsScalar() && preset.Scalar().empty())) {
       if (!preset.IsScalar()) config::detail::throwAt(doc, preset, "rig.event_camera.preset", "expected a file path");
       const std::string path = resolvePath(preset.Scalar(), base_dir, search_root,
                                            config::where(doc, preset, "rig.event_camera.preset"));
       config::fill(config::loadFile(path), "", o.rig.event_camera.sensor);
     }
   }
-  config::Document camera_doc{cam_node.IsDefined() ? YAML::Clone(cam_node) : YAML::Node(YAML::NodeType::Map),
-                              doc.file, overriddenBelow(doc, "rig.event_camera")};
+  config::Document camera_doc{cam_node.IsDefined() ? cam_node : YAML::Node(YAML::NodeType::Map), doc.file,
+                              overriddenBelow(doc, "rig.event_camera")};
   config::fill(camera_doc, "", o.rig.event_camera);
 
-  // 2. Every other field (scene, trajectory and the event camera taken out).
-  config::Document rest{YAML::Clone(doc.root), doc.file, doc.overridden};
-  rest.root.remove(kScene);
-  rest.root.remove(kTrajectory);
-  rest.root.remove("version");
-  if (rest.root["rig"].IsMap()) rest.root["rig"].remove("event_camera");
-  config::fill(rest, "", o);
+  // 2. Every other field: the sections read on their own are taken out of
+  // the (local) document, which keeps its nodes' line numbers (a clone would not).
+  const YAML::Node scene_node = doc.root[kScene];
+  const YAML::Node traj_node = doc.root[kTrajectory];
+  doc.root.remove(kScene);
+  doc.root.remove(kTrajectory);
+  doc.root.remove("version");
+  if (rig_node.IsMap()) doc.root["rig"].remove("event_camera");
+  config::fill(doc, "", o);
 
   // 3. The trajectory, with the scenario's seed.
-  const YAML::Node traj_node = doc.root[kTrajectory];
   if (!traj_node.IsDefined() || traj_node.IsNull()) throw Error(doc.file + ": trajectory: missing");
   std::string traj_dir;
   std::optional<config::Document> traj_preset;
@@ -180,7 +181,6 @@ Scenario loadScenarioDocument(config::Document doc, const std::string& base_dir,
                 std::to_string(nsToSeconds(s.trajectory->endTime() - s.trajectory->startTime())) + " s)");
 
   // 6. The scene.
-  const YAML::Node scene_node = doc.root[kScene];
   if (!scene_node.IsDefined() || scene_node.IsNull()) throw Error(doc.file + ": scene: missing");
   std::string scene_dir;
   std::optional<config::Document> scene_preset;

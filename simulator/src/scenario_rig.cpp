@@ -69,11 +69,22 @@ void RangeFinderRigOptions::validate() const {
   requireNonNegative("noise_sigma_m", noise_sigma_m);
 }
 
+namespace {
+template <class O>
+void validateIn(const char* section, const O& options) {
+  try {
+    options.validate();
+  } catch (const Error& e) {
+    throw Error(std::string(section) + "." + e.what());
+  }
+}
+}  // namespace
+
 void RigOptions::validate() const {
-  event_camera.validate();
-  frame_camera.validate();
-  imu.validate();
-  range_finder.validate();
+  validateIn("event_camera", event_camera);
+  validateIn("frame_camera", frame_camera);
+  validateIn("imu", imu);
+  validateIn("range_finder", range_finder);
 }
 
 void RenderScheduleOptions::validate() const {
@@ -97,21 +108,9 @@ void ScenarioOptions::validate() const {
   requireNonNegative("start_s", start_s);
   requirePositive("duration_s", duration_s);
   requireInRange("threads", threads, 0, 1024);
-  try {
-    rig.validate();
-  } catch (const Error& e) {
-    throw Error(std::string("rig.") + e.what());
-  }
-  try {
-    sampling.validate();
-  } catch (const Error& e) {
-    throw Error(std::string("sampling.") + e.what());
-  }
-  try {
-    output.validate();
-  } catch (const Error& e) {
-    throw Error(std::string("output.") + e.what());
-  }
+  validateIn("rig", rig);
+  validateIn("sampling", sampling);
+  validateIn("output", output);
 }
 
 Camera Scenario::eventCamera() const {

@@ -1,0 +1,142 @@
+// Scenario loading (scenario.h): every shipped scenario loads and its
+// resolved form round-trips; presets, merges, overrides and bad input.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "evio/core/error.h"
+#include "evio/simulator/scenario.h"
+
+namespace evio::simulator {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string>& shippedScenarios() {
+  static const std::vector<std::string> names = {
+      "mars_yard_circle", "lava_tube_entry",  "mars_hover",     "mars_rotation",
+      "mars_flight",      "poster_6dof",      "poster_translation", "poster_rotation",
+      "shapes_6dof",      "shapes_rotation",  "boxes_6dof",     "boxes_rotation"};
+  return names;
+}
+
+std::string scenarioPath(const std::string& name) {
+  return std::string(EVIO_SOURCE_DIR) + "/experiments/scenarios/" + name + ".yaml";
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scenario, EveryShippedScenarioLoadsAndItsResolvedFormRoundTrips) {
+  for (const auto& name : shippedScenarios()) {
+    SCOPED_TRACE(name);
+    const Scenario s = loadScenario(scenarioPath(name), {}, EVIO_SOURCE_DIR);
+    EXPECT_FALSE(s.options.description.empty());
+    EXPECT_GT(s.end_ns, s.start_ns);
+    EXPECT_LE(s.end_ns, s.trajectory->endTime());
+    const SensorRig rig = s.sensorRig();
+    EXPECT_EQ(rig.cameras.front().role, CameraRole::kEvent);
+    // The camera looks at the scene: its optical axis at the start points
+    // down or ahead, never up into the sky.
+    const Pose T_W_E = s.trajectory->evaluate(s.start_ns).T_W_B * s.T_B_E();
+    EXPECT_LT(T_W_E.rotation().col(2).z(), 0.1);
+    // Resolved YAML: loading it gives the same resolved YAML.
+    const std::string resolved = s.resolvedYaml();
+    const Scenario again = loadScenarioString(resolved, name + " (resolved)", "", {}, EVIO_SOURCE_DIR);
+    EXPECT_EQ(again.resolvedYaml(), resolved);
+  }
+}
+
+TEST(Scenario, ShippedDefaultsArePhysicallySensible) {
+  const Scenario yard = loadScenario(scenarioPath("mars_yard_circle"), {}, EVIO_SOURCE_DIR);
+  EXPECT_EQ(yard.options.rig.event_camera.sensor.width, 346);  // DAVIS346 from the preset
+  EXPECT_EQ(yard.options.rig.imu.gravity_mps2, 9.81);          // the Mars Yard is on Earth
+  EXPECT_LE(yard.options.duration_s, 10.0);                    // short: the main job runs it
+  const Scenario hover = loadScenario(scenarioPath("mars_hover"), {}, EVIO_SOURCE_DIR);
+  EXPECT_EQ(hover.options.rig.imu.gravity_mps2, 3.721);        // Mars, from the trajectory
+  EXPECT_TRUE(hover.sensorRig().range_finder.has_value());
+  const Scenario poster = loadScenario(scenarioPath("poster_6dof"), {}, EVIO_SOURCE_DIR);
+  EXPECT_EQ(poster.eventCamera().model(), "radtan");
+  EXPECT_EQ(poster.eventCamera().width(), 240);
+}
+
+TEST(Scenario, OverridesReachPresetSections) {
+  const Scenario s = loadScenario(scenarioPath("mars_yard_circle"),
+                                  {"duration_s=2", "seed=5", "trajectory.diameter_m=2.5",
+                                   "rig.event_camera.event_camera.threshold_pos=0.3", "scene.seed=9"},
+                                  EVIO_SOURCE_DIR);
+  EXPECT_EQ(s.end_ns - s.start_ns, 2 * kNsPerSecond);
+  EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_pos, 0.3);
+  EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_neg, 0.2);  // kept from the preset
+  EXPECT_EQ(s.scene.options.seed, 9u);
+  const std::string yaml = s.resolvedYaml();
+  EXPECT_NE(yaml.find("diameter_m: 2.5"), std::string::npos);
+  EXPECT_NE(yaml.find("seed: 5"), std::string::npos);  // the trajectory takes the scenario's seed
+  EXPECT_EQ(yaml.find("\nthreads:"), std::string::npos) << "threads never change the output";
+}
+
+TEST(Scenario, BadInputNamesFileLineAndField) {
+  const std::string base = R"(
+scene: scenes/presets/ec_shapes.yaml
+trajectory: trajectories/presets/hover.yaml
+rig:
+  event_camera: {preset: simulator/presets/davis240c.yaml}
+)";
+  const auto load = [&](const std::string& extra) {
+    return errorOf([&] { loadScenarioString(base + extra, "bad.yaml", "", {}, EVIO_SOURCE_DIR); });
+  };
+  EXPECT_EQ(load(""), "");
+  std::string e = load("  imu: {bogus_key: 1}\n");
+  EXPECT_NE(e.find("bad.yaml:6"), std::string::npos) << e;
+  EXPECT_NE(e.find("bogus_key"), std::string::npos) << e;
+  e = load("duration_s: -1\n");
+  EXPECT_NE(e.find("duration_s"), std::string::npos) << e;
+  e = load("duration_s: 100\n");  // the hover preset lasts 60 s
+  EXPECT_NE(e.find("past the end of the trajectory"), std::string::npos) << e;
+  e = load("  frame_camera: {rate_hz: 20, sensor: {auto_exposure_max_s: 0.1}}\n");
+  EXPECT_NE(e.find("auto_exposure_max_s"), std::string::npos) << e;
+  e = errorOf([&] {
+    loadScenarioString(base + "  range_finder: {enabled: true, T_B_L: [1,0,0,0, 0,1,0,0, 0,0,2,0, 0,0,0,1]}\n",
+                       "bad.yaml", "", {}, EVIO_SOURCE_DIR);
+  });
+  EXPECT_NE(e.find("T_B_L"), std::string::npos) << e;
+  e = errorOf([&] { loadScenarioString("scene: nowhere.yaml\ntrajectory: trajectories/presets/hover.yaml\n",
+                                       "bad.yaml", "", {}, EVIO_SOURCE_DIR); });
+  EXPECT_NE(e.find("nowhere.yaml"), std::string::npos) << e;
+  e = errorOf([&] {
+    loadScenarioString("scene: scenes/presets/ec_shapes.yaml\ntrajectory: trajectories/presets/hover.yaml\n",
+                       "bad.yaml", "", {}, EVIO_SOURCE_DIR);
+  });
+  EXPECT_NE(e.find("resolution"), std::string::npos) << e;  // no event sensor given
+  e = errorOf([&] {
+    loadScenarioString(base + "  event_camera: {preset: simulator/presets/davis240c.yaml, model: equidistant}\n",
+                       "bad.yaml", "", {}, EVIO_SOURCE_DIR);
+  });
+  EXPECT_FALSE(e.empty());
+}
+
+TEST(Scenario, InlineSectionsNeedNoPresetFiles) {
+  const char* text = R"(
+duration_s: 1
+scene:
+  lights: [{type: sky, radiance_w_m2_sr: 2}]
+  materials: [{name: m, model: lambertian, albedo: {type: constant, value: 0.5}}]
+  sources: [{type: plane, name: floor, material: m, size_m: [10, 10]}]
+trajectory: {type: hover, duration_s: 5, center_m: [0, 0, 2]}
+rig:
+  event_camera: {name: tiny, width: 32, height: 24, intrinsics: [30, 30, 15.5, 11.5], pixel_pitch_um: 10}
+)";
+  const Scenario s = loadScenarioString(text, "inline.yaml", "", {}, "");
+  EXPECT_EQ(s.eventCamera().width(), 32);
+  EXPECT_EQ(s.scene.options.sources.size(), 1u);
+  EXPECT_EQ(s.options.rig.imu.gravity_mps2, 3.721);  // hover's default gravity
+}
+
+}  // namespace
+}  // namespace evio::simulator

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <sstream>
 
@@ -167,6 +168,8 @@ std::string SimulationStats::toYaml() const {
     << "simulated_s: " << simulated_s << "\n"
     << "wall_s: " << wall_s << "\n"
     << "simulated_s_per_wall_s: " << realTimeFactor() << "\n"
+    << "cpu_s: " << cpu_s << "   # process CPU time, all threads (robust to other load on the machine)\n"
+    << "simulated_s_per_cpu_s: " << (cpu_s > 0 ? simulated_s / cpu_s : 0.0) << "\n"
     << "resolution: [" << width << ", " << height << "]\n"
     << "renders: " << renders << "\n"
     << "renders_per_simulated_s: " << (simulated_s > 0 ? static_cast<double>(renders) / simulated_s : 0.0) << "\n"
@@ -200,6 +203,7 @@ std::string SimulationStats::toYaml() const {
 SimulationStats simulateSequence(const Scenario& scenario, const std::string& folder,
                                  const ProgressCallback& progress) {
   const auto t_start = Clock::now();
+  const std::clock_t cpu_start = std::clock();
   SimulationStats stats;
   const auto& o = scenario.options;
   stats.simulated_s = nsToSeconds(scenario.end_ns - scenario.start_ns);
@@ -257,6 +261,7 @@ SimulationStats simulateSequence(const Scenario& scenario, const std::string& fo
   stats.truth_s += secondsSince(t0);
 
   stats.wall_s = secondsSince(t_start);
+  stats.cpu_s = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   const std::string stats_path = path(folder, "simulation_stats.yaml");
   io::writeFileAtomic(stats_path, stats.toYaml());
   stats.files.push_back(stats_path);

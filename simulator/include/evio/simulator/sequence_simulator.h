@@ -60,6 +60,7 @@ using ProgressCallback = std::function<void(const SimulationProgress&)>;
 struct SimulationStats {
   double simulated_s = 0.0;
   double wall_s = 0.0;               ///< everything, scene build included
+  double cpu_s = 0.0;                ///< process CPU time over the run (all threads), s
   double scene_build_s = 0.0;
   double render_s = 0.0;             ///< event-camera renders (flow included)
   double frame_render_s = 0.0;       ///< separate frame-camera renders

@@ -13,6 +13,8 @@ void addTrackCommand(CLI::App& app);
 void addEvaluateTracksCommand(CLI::App& app);
 void addEvaluateCommand(CLI::App& app);
 void addCampaignCommand(CLI::App& app);
+void addReportCommand(CLI::App& app);
+void addExportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 
 }  // namespace evio::apps

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   evio::apps::addEvaluateTracksCommand(app);
   evio::apps::addEvaluateCommand(app);
   evio::apps::addCampaignCommand(app);
+  evio::apps::addReportCommand(app);
+  evio::apps::addExportCommand(app);
   evio::apps::addSimulateCommand(app);
   try {
     app.parse(argc, argv);

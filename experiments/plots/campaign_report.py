@@ -1,0 +1,268 @@
+#!/usr/bin/python3
+"""Plots of a campaign's results, for `evio report`.
+
+Usage: campaign_report.py RESULTS REPORT_DIR GROUPS_CSV
+
+Reads RESULTS/summary.csv (one row per job), the per-job series
+RESULTS/jobs/<id>/metrics_poses.csv (t_s, distance_m, gt_x.., es_x..,
+position_m, rotation_deg, yaw_deg, gravity_deg, nees_*) and
+RESULTS/jobs/<id>/metrics_rtf.csv (t_s, rtf, event_rate_hz), and GROUPS_CSV
+(written by `evio report`: the ANEES bounds per group). Writes into
+REPORT_DIR:
+  box_mpe.png, box_ate.png, box_mye.png  Monte Carlo box plots per scenario and method (successful runs)
+  success.png                            ok / diverged / failed per scenario and method
+  error_vs_distance.png, error_vs_time.png  position error of every run, median per method
+  trajectories_<scenario>.png            top view (x-y) of the aligned estimates against ground truth
+  nees.png                               average NEES over the runs against time, with 95 % chi-square bounds
+  rtf_vs_event_rate.png                  real-time factor of 0.2 s intervals against the event rate
+and plots.txt: one line per figure, "wrote NAME" or "skipped NAME: reason".
+"""
+
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+lines = []
+
+
+def note(text):
+    lines.append(text)
+    print(f"campaign_report: {text}")
+
+
+def number(text):
+    try:
+        v = float(text)
+        return v if math.isfinite(v) else None
+    except (TypeError, ValueError):
+        return None
+
+
+def variant(row):
+    return row["method"] + (f"\n{row['sweep']}" if row["sweep"] else "")
+
+
+def load_series(path):
+    if not os.path.isfile(path):
+        return None
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        cols = {k: [] for k in reader.fieldnames}
+        for r in reader:
+            for k in cols:
+                cols[k].append(number(r[k]))
+    return {k: np.array([np.nan if v is None else v for v in vals]) for k, vals in cols.items()}
+
+
+def save(fig, out, name):
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, name), dpi=110)
+    plt.close(fig)
+    note(f"wrote {name}")
+
+
+def box_plot(rows, scenarios, out, key, label, name):
+    ok = [r for r in rows if r["status"] == "ok" and number(r.get(key)) is not None]
+    if not ok:
+        note(f"skipped {name}: no successful run has {key}")
+        return
+    fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
+    for ax, sc in zip(axes[0], scenarios):
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        data = [[number(r[key]) for r in ok if r["scenario"] == sc and variant(r) == v] for v in variants]
+        present = [(v, d) for v, d in zip(variants, data) if d]
+        if present:
+            ax.boxplot([d for _, d in present], labels=[v for v, _ in present], showmeans=True)
+        ax.set_title(sc)
+        ax.set_ylabel(label)
+        ax.tick_params(axis="x", labelsize=7)
+        ax.grid(alpha=0.3)
+    save(fig, out, name)
+
+
+def success_plot(rows, scenarios, out):
+    fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
+    for ax, sc in zip(axes[0], scenarios):
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        bottom = np.zeros(len(variants))
+        for status, colour in (("ok", "tab:green"), ("diverged", "tab:orange"), ("failed", "tab:red")):
+            counts = np.array([sum(1 for r in rows if r["scenario"] == sc and variant(r) == v and
+                                   r["done"] == "1" and r["status"] == status) for v in variants], float)
+            ax.bar(range(len(variants)), counts, bottom=bottom, color=colour, label=status)
+            bottom += counts
+        ax.set_xticks(range(len(variants)), variants, fontsize=7)
+        ax.set_ylabel("runs")
+        ax.set_title(sc)
+        ax.legend(fontsize=7)
+    save(fig, out, "success.png")
+
+
+def error_plots(rows, scenarios, results, out):
+    series = {}
+    for r in rows:
+        if r["done"] == "1" and r["status"] != "failed":
+            s = load_series(os.path.join(results, "jobs", r["job_id"], "metrics_poses.csv"))
+            if s is not None and len(s["t_s"]) > 0:
+                series[r["job_id"]] = s
+    if not series:
+        for name in ("error_vs_distance.png", "error_vs_time.png", "trajectories.png"):
+            note(f"skipped {name}: no job has metrics_poses.csv")
+        return series
+    for axis, xlabel, name in (("distance_m", "distance travelled [m]", "error_vs_distance.png"),
+                               ("t_s", "time [s]", "error_vs_time.png")):
+        fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
+        for ax, sc in zip(axes[0], scenarios):
+            variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+            for i, v in enumerate(variants):
+                colour = f"C{i}"
+                runs = [series[r["job_id"]] for r in rows
+                        if r["scenario"] == sc and variant(r) == v and r["job_id"] in series]
+                for s in runs:
+                    ax.plot(s[axis], s["position_m"], color=colour, alpha=0.25, lw=0.7)
+                if runs:
+                    hi = min(np.nanmax(s[axis]) for s in runs)
+                    lo = max(np.nanmin(s[axis]) for s in runs)
+                    if hi > lo:
+                        grid = np.linspace(lo, hi, 200)
+                        med = np.nanmedian([np.interp(grid, s[axis], s["position_m"]) for s in runs], axis=0)
+                        ax.plot(grid, med, color=colour, lw=2, label=v.replace("\n", " "))
+            ax.set_title(sc)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel("position error [m]")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=6)
+        save(fig, out, name)
+    for sc in scenarios:
+        fig, ax = plt.subplots(figsize=(5.5, 5))
+        drawn_gt = False
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        for i, v in enumerate(variants):
+            runs = sorted((r for r in rows if r["scenario"] == sc and variant(r) == v and r["job_id"] in series),
+                          key=lambda r: int(r["seed"]))
+            if not runs:
+                continue
+            s = series[runs[0]["job_id"]]
+            if not drawn_gt:
+                ax.plot(s["gt_x"], s["gt_y"], "k-", lw=2, label=f"ground truth (seed {runs[0]['seed']})")
+                drawn_gt = True
+            ax.plot(s["es_x"], s["es_y"], color=f"C{i}", lw=1, label=f"{v.replace(chr(10), ' ')} (seed {runs[0]['seed']})")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_title(f"{sc}: top view, aligned estimates")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=6)
+        save(fig, out, f"trajectories_{sc}.png")
+    return series
+
+
+def nees_plot(rows, scenarios, series, groups, out):
+    with_nees = {k: s for k, s in series.items() if "nees_pose" in s and np.isfinite(s["nees_pose"]).any()}
+    if not with_nees:
+        note("skipped nees.png: no job has pose covariances (trajectory_covariance.txt)")
+        return
+    fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
+    for ax, sc in zip(axes[0], scenarios):
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        for i, v in enumerate(variants):
+            runs = [with_nees[r["job_id"]] for r in rows
+                    if r["scenario"] == sc and variant(r) == v and r["job_id"] in with_nees]
+            if not runs:
+                continue
+            # Average over runs on a 0.1 s grid (each run's sample nearest to the grid time).
+            t0 = max(np.nanmin(s["t_s"]) for s in runs)
+            t1 = min(np.nanmax(s["t_s"]) for s in runs)
+            if t1 <= t0:
+                continue
+            grid = np.arange(t0, t1, 0.1)
+            per_run = []
+            for s in runs:
+                ok = np.isfinite(s["nees_pose"])
+                t, n = s["t_s"][ok], s["nees_pose"][ok]
+                idx = np.clip(np.searchsorted(t, grid), 1, len(t) - 1)
+                near = np.where(np.abs(t[idx - 1] - grid) < np.abs(t[idx] - grid), idx - 1, idx)
+                per_run.append(n[near])
+            anees = np.mean(per_run, axis=0)
+            label = v.replace("\n", " ")
+            ax.plot(grid, anees, color=f"C{i}", lw=1, label=f"{label} ({len(runs)} runs)")
+            key = (sc, v.split("\n")[0], v.split("\n")[1] if "\n" in v else "")
+            if key in groups:
+                lo, hi = groups[key]
+                ax.axhline(lo, color=f"C{i}", ls="--", lw=0.8)
+                ax.axhline(hi, color=f"C{i}", ls="--", lw=0.8)
+        ax.axhline(6.0, color="k", lw=0.5)
+        ax.set_yscale("log")
+        ax.set_title(sc)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("average NEES (6 dof); dashed: 95 % bounds")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=6)
+    save(fig, out, "nees.png")
+
+
+def rtf_plot(rows, results, out):
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    methods = sorted({r["method"] for r in rows})
+    any_drawn = False
+    for i, m in enumerate(methods):
+        xs, ys = [], []
+        for r in rows:
+            if r["method"] != m or r["done"] != "1":
+                continue
+            s = load_series(os.path.join(results, "jobs", r["job_id"], "metrics_rtf.csv"))
+            if s is not None and len(s["rtf"]) > 0:
+                xs.append(s["event_rate_hz"])
+                ys.append(s["rtf"])
+        if xs:
+            ax.scatter(np.concatenate(xs), np.concatenate(ys), s=4, alpha=0.4, color=f"C{i}", label=m)
+            any_drawn = True
+    if not any_drawn:
+        plt.close(fig)
+        note("skipped rtf_vs_event_rate.png: no job has timing.txt (metrics_rtf.csv)")
+        return
+    ax.axhline(1.0, color="k", lw=0.8, ls="--")
+    ax.set_xlabel("event rate [events/s]")
+    ax.set_ylabel("real-time factor (0.2 s intervals)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    save(fig, out, "rtf_vs_event_rate.png")
+
+
+def main():
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    results, out, groups_csv = sys.argv[1:4]
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(results, "summary.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    groups = {}
+    if os.path.isfile(groups_csv):
+        with open(groups_csv, newline="") as f:
+            for g in csv.DictReader(f):
+                lo, hi = number(g["anees_lower_95"]), number(g["anees_upper_95"])
+                if lo is not None and hi is not None:
+                    groups[(g["scenario"], g["method"], g["sweep"])] = (lo, hi)
+    scenarios = list(dict.fromkeys(r["scenario"] for r in rows))
+    if not rows:
+        note("skipped all plots: summary.csv has no jobs")
+    else:
+        box_plot(rows, scenarios, out, "paper.mpe_percent", "MPE [%]", "box_mpe.png")
+        box_plot(rows, scenarios, out, "ate.position_m.rmse", "ATE RMSE [m]", "box_ate.png")
+        box_plot(rows, scenarios, out, "paper.mye_deg_per_m", "MYE [deg/m]", "box_mye.png")
+        success_plot(rows, scenarios, out)
+        series = error_plots(rows, scenarios, results, out)
+        nees_plot(rows, scenarios, series, groups, out)
+        rtf_plot(rows, results, out)
+    with open(os.path.join(out, "plots.txt"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()

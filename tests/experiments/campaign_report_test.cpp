@@ -1,0 +1,74 @@
+#include "evio/experiments/campaign_report.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "evio/experiments/campaign_results.h"
+#include "evio/experiments/nees.h"
+
+namespace evio::experiments {
+namespace {
+
+TEST(CampaignReport, SpreadIsMedianAndQuartiles) {
+  const Spread s = spreadOf({5.0, 1.0, 3.0, 2.0, 4.0, NAN});
+  EXPECT_EQ(s.count, 5u);
+  EXPECT_DOUBLE_EQ(s.median, 3.0);
+  EXPECT_DOUBLE_EQ(s.q1, 2.0);
+  EXPECT_DOUBLE_EQ(s.q3, 4.0);
+  const Spread even = spreadOf({1.0, 2.0, 3.0, 4.0});
+  EXPECT_DOUBLE_EQ(even.median, 2.5);
+  EXPECT_DOUBLE_EQ(even.q1, 1.75);
+  EXPECT_TRUE(std::isnan(spreadOf({}).median));
+}
+
+TEST(CampaignReport, AggregatesRunsPerScenarioMethodAndSweep) {
+  const std::string summary =
+      "job_id,scenario,method,sweep,seed,done,status,cause,alignment.describe,paper.mpe_percent,"
+      "paper.mye_deg_per_m,ate.position_m.rmse,ate.rotation_deg.rmse,completion.share,nees.available,"
+      "nees.mean_pose,rtf.available,rtf.median,rtf.max\n"
+      "a1,hover,eklt,,1,1,ok,,posyaw on all poses (10),1.0,0.1,0.01,0.5,1,true,5.0,true,0.5,0.9\n"
+      "a2,hover,eklt,,2,1,ok,,posyaw on all poses (10),3.0,0.3,0.03,0.7,1,true,7.0,true,0.7,1.4\n"
+      "a3,hover,eklt,,3,1,diverged,\"bound, exceeded\",posyaw on all poses (10),50,5,2,9,0.4,true,600,true,0.6,0.8\n"
+      "a4,hover,eklt,,4,1,failed,estimate: exit code 3,,,,,,,,,,,\n"
+      "a5,hover,eklt,,5,0,,,,,,,,,,,,,\n"
+      "b1,hover,klt,x=1,1,1,ok,,posyaw on all poses (10),2.0,0.2,0.02,0.6,1,false,,false,,\n";
+  const CampaignReport r = aggregateSummary(parseCsv(summary));
+  EXPECT_EQ(r.jobs, 6u);
+  EXPECT_EQ(r.finished, 5u);
+  ASSERT_EQ(r.groups.size(), 2u);
+  const ReportGroup& g = r.groups[0];
+  EXPECT_EQ(g.method, "eklt");
+  EXPECT_EQ(g.runs, 5u);
+  EXPECT_EQ(g.ok, 2u);
+  EXPECT_EQ(g.diverged, 1u);
+  EXPECT_EQ(g.failed, 1u);
+  EXPECT_EQ(g.pending, 1u);
+  EXPECT_DOUBLE_EQ(g.successRate(), 0.4);
+  EXPECT_EQ(g.alignment, "posyaw on all poses");
+  EXPECT_DOUBLE_EQ(g.mpe_percent.median, 2.0);  // successful runs only: 1 and 3
+  EXPECT_EQ(g.completion.count, 3u);            // every finished, not failed run
+  EXPECT_EQ(g.nees_runs, 3u);
+  EXPECT_DOUBLE_EQ(g.anees, (5.0 + 7.0 + 600.0) / 3.0);
+  const auto [lo, hi] = neesBounds(6, 3);
+  EXPECT_DOUBLE_EQ(g.anees_lower, lo);
+  EXPECT_DOUBLE_EQ(g.anees_upper, hi);
+  EXPECT_DOUBLE_EQ(g.rtf_median.median, 0.6);
+  EXPECT_DOUBLE_EQ(g.rtf_max, 1.4);
+  EXPECT_EQ(r.groups[1].sweep, "x=1");
+  EXPECT_EQ(r.groups[1].nees_runs, 0u);
+
+  const std::string md = reportMarkdown(r, "Test", {"box_mpe.png"}, {"skipped nees.png: no covariance"});
+  EXPECT_NE(md.find("## hover"), std::string::npos);
+  EXPECT_NE(md.find("| eklt | – | 5 (1 pending) | 40 % | 1 | 1 | 2.00 [1.50, 2.50] |"), std::string::npos) << md;
+  EXPECT_NE(md.find("✗"), std::string::npos);  // ANEES 204 is outside its bounds
+  EXPECT_NE(md.find("![box_mpe.png](box_mpe.png)"), std::string::npos);
+  EXPECT_NE(md.find("- skipped nees.png: no covariance"), std::string::npos);
+  const auto csv = parseCsv(reportCsv(r));
+  ASSERT_EQ(csv.size(), 3u);
+  EXPECT_EQ(csv[1].size(), csv[0].size());
+  EXPECT_EQ(csv[2][2], "x=1");
+}
+
+}  // namespace
+}  // namespace evio::experiments

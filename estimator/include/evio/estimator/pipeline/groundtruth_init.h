@@ -1,0 +1,38 @@
+#pragma once
+/// @file groundtruth_init.h
+/// The paper's initialisation protocol (eklt-vio-paper.tex, Experiments;
+/// ALGORITHMS.md): the filter starts from the ground-truth pose and velocity
+/// with zero IMU biases.
+///
+/// groundtruth.txt holds T_W_C(t), the camera (event camera) in W on the
+/// camera clock. The body (IMU) state at camera time t is
+///   T_W_B(t) = T_W_C(t) · T_B_C⁻¹,
+/// with T_W_C(t) interpolated between the neighbouring poses (position
+/// linearly, rotation by slerp), and the velocity of B by a central difference
+///   v_W(t) = (p_W_B(t + h) − p_W_B(t − h)) / 2h,
+/// the window [t − h, t + h] clipped to the span of the ground truth.
+
+#include <string>
+
+#include "evio/core/pose.h"
+#include "evio/core/time.h"
+#include "evio/estimator/backend/filter_state.h"
+
+namespace evio::estimator {
+
+/// T_W_C at t_ns, interpolated; throws evio::Error when t_ns is outside the
+/// trajectory's span or the trajectory is empty.
+Pose interpolatePose(const Trajectory& T_W_C, TimeNs t_ns);
+
+/// The body state at camera time t_cam_ns from the camera trajectory T_W_C
+/// (see the file comment). state.t_ns = t_cam_ns + time_offset_cam_imu_ns (the
+/// IMU clock, as Backend::initialize wants it); biases zero.
+ImuState initialStateFromTrajectory(const Trajectory& T_W_C, TimeNs t_cam_ns, const Pose& T_B_C,
+                                    double half_window_s, TimeNs time_offset_cam_imu_ns = 0);
+
+/// Reads the beginning of a TUM file (groundtruth.txt), up to the first pose
+/// after `t_until_ns` (all of it when the file ends earlier): memory stays
+/// flat for long sequences.
+Trajectory readTrajectoryPrefix(const std::string& path, TimeNs t_until_ns);
+
+}  // namespace evio::estimator

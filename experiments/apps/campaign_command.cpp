@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -31,14 +32,28 @@ std::string selfBinary() { return fs::read_symlink("/proc/self/exe").string(); }
 
 std::string absolutePath(const std::string& p) { return fs::absolute(p).lexically_normal().string(); }
 
-void printOutcome(const experiments::CampaignProgress& p) {
-  if (!p.last) return;
-  const std::size_t done = p.skipped + p.finished;
-  std::printf("[%*zu/%zu] %-44s %-8s %6.1f s%s%s\n", static_cast<int>(std::to_string(p.total).size()), done, p.total,
-              p.last->id.c_str(), p.last->status.c_str(), p.last->wall_s, p.last->cause.empty() ? "" : "  ",
-              p.last->cause.c_str());
-  std::fflush(stdout);
-}
+/// One line per finished job: "[done/total, failed, ETA] id status time cause".
+class OutcomePrinter {
+ public:
+  void operator()(const experiments::CampaignProgress& p) {
+    if (!p.last) return;
+    const std::size_t done = p.skipped + p.finished;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const std::size_t left = p.total - done;
+    const double eta_s = p.finished > 0 ? elapsed / static_cast<double>(p.finished) * static_cast<double>(left) : 0.0;
+    char eta[32];
+    if (eta_s >= 3600) std::snprintf(eta, sizeof(eta), "%dh%02dm", int(eta_s / 3600), int(eta_s / 60) % 60);
+    else if (eta_s >= 60) std::snprintf(eta, sizeof(eta), "%dm%02ds", int(eta_s / 60), int(eta_s) % 60);
+    else std::snprintf(eta, sizeof(eta), "%.0fs", eta_s);
+    std::printf("[%*zu/%zu, %zu failed, ETA %s] %-40s %-8s %6.1f s%s%s\n",
+                static_cast<int>(std::to_string(p.total).size()), done, p.total, p.failed, eta, p.last->id.c_str(),
+                p.last->status.c_str(), p.last->wall_s, p.last->cause.empty() ? "" : "  ", p.last->cause.c_str());
+    std::fflush(stdout);
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
 
 }  // namespace
 
@@ -112,7 +127,7 @@ void addCampaignCommand(CLI::App& app) {
     experiments::RunnerOptions options;
     options.results = absolutePath(args->results);
     options.evio_binary = selfBinary();
-    const auto outcomes = experiments::runCampaign(campaign, jobs, options, printOutcome);
+    const auto outcomes = experiments::runCampaign(campaign, jobs, options, OutcomePrinter());
     std::printf("task %d: %zu jobs\n", args->task, outcomes.size());
   });
 
@@ -152,8 +167,9 @@ void addCampaignCommand(CLI::App& app) {
     options.evio_binary = selfBinary();
     ProgressLine line("campaign " + campaign.name, " jobs", args->quiet);
     const bool quiet = args->quiet;
+    OutcomePrinter printOutcome;
     const auto outcomes = experiments::runCampaign(
-        campaign, jobs, options, [&line, quiet](const experiments::CampaignProgress& p) {
+        campaign, jobs, options, [&line, &printOutcome, quiet](const experiments::CampaignProgress& p) {
           if (!p.last && !quiet)
             std::printf("campaign: %zu jobs, %zu done already, %zu to run\n", p.total, p.skipped,
                         p.total - p.skipped);

@@ -46,7 +46,20 @@ def number(text):
 
 
 def variant(row):
-    return row["method"] + (f"\n{row['sweep']}" if row["sweep"] else "")
+    """The group of a run within its scenario: (method, sweep)."""
+    return (row["method"], row["sweep"])
+
+
+def label(v, newline=True):
+    """Short text for a variant: the method and the sweep values (keys in sweep_keys())."""
+    method, sweep = v
+    values = ",".join(kv.split("=", 1)[-1] for kv in sweep.split(";")) if sweep else ""
+    return method + (("\n" if newline else " ") + values if values else "")
+
+
+def sweep_keys(rows):
+    keys = [kv.split("=", 1)[0] for kv in rows[0]["sweep"].split(";")] if rows and rows[0]["sweep"] else []
+    return ", ".join(keys)
 
 
 def load_series(path):
@@ -68,7 +81,7 @@ def save(fig, out, name):
     note(f"wrote {name}")
 
 
-def box_plot(rows, scenarios, out, key, label, name):
+def box_plot(rows, scenarios, out, key, ylabel, name):
     ok = [r for r in rows if r["status"] == "ok" and number(r.get(key)) is not None]
     if not ok:
         note(f"skipped {name}: no successful run has {key}")
@@ -79,9 +92,11 @@ def box_plot(rows, scenarios, out, key, label, name):
         data = [[number(r[key]) for r in ok if r["scenario"] == sc and variant(r) == v] for v in variants]
         present = [(v, d) for v, d in zip(variants, data) if d]
         if present:
-            ax.boxplot([d for _, d in present], labels=[v for v, _ in present], showmeans=True)
+            ax.boxplot([d for _, d in present], labels=[label(v) for v, _ in present], showmeans=True)
         ax.set_title(sc)
-        ax.set_ylabel(label)
+        if sweep_keys(rows):
+            ax.set_xlabel(f"method, {sweep_keys(rows)}", fontsize=8)
+        ax.set_ylabel(ylabel)
         ax.tick_params(axis="x", labelsize=7)
         ax.grid(alpha=0.3)
     save(fig, out, name)
@@ -97,7 +112,9 @@ def success_plot(rows, scenarios, out):
                                    r["done"] == "1" and r["status"] == status) for v in variants], float)
             ax.bar(range(len(variants)), counts, bottom=bottom, color=colour, label=status)
             bottom += counts
-        ax.set_xticks(range(len(variants)), variants, fontsize=7)
+        ax.set_xticks(range(len(variants)), [label(v) for v in variants], fontsize=7)
+        if sweep_keys(rows):
+            ax.set_xlabel(f"method, {sweep_keys(rows)}", fontsize=8)
         ax.set_ylabel("runs")
         ax.set_title(sc)
         ax.legend(fontsize=7)
@@ -132,7 +149,7 @@ def error_plots(rows, scenarios, results, out):
                     if hi > lo:
                         grid = np.linspace(lo, hi, 200)
                         med = np.nanmedian([np.interp(grid, s[axis], s["position_m"]) for s in runs], axis=0)
-                        ax.plot(grid, med, color=colour, lw=2, label=v.replace("\n", " "))
+                        ax.plot(grid, med, color=colour, lw=2, label=label(v, newline=False))
             ax.set_title(sc)
             ax.set_xlabel(xlabel)
             ax.set_ylabel("position error [m]")
@@ -152,7 +169,7 @@ def error_plots(rows, scenarios, results, out):
             if not drawn_gt:
                 ax.plot(s["gt_x"], s["gt_y"], "k-", lw=2, label=f"ground truth (seed {runs[0]['seed']})")
                 drawn_gt = True
-            ax.plot(s["es_x"], s["es_y"], color=f"C{i}", lw=1, label=f"{v.replace(chr(10), ' ')} (seed {runs[0]['seed']})")
+            ax.plot(s["es_x"], s["es_y"], color=f"C{i}", lw=1, label=f"{label(v, newline=False)} (seed {runs[0]['seed']})")
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
@@ -190,9 +207,8 @@ def nees_plot(rows, scenarios, series, groups, out):
                 near = np.where(np.abs(t[idx - 1] - grid) < np.abs(t[idx] - grid), idx - 1, idx)
                 per_run.append(n[near])
             anees = np.mean(per_run, axis=0)
-            label = v.replace("\n", " ")
-            ax.plot(grid, anees, color=f"C{i}", lw=1, label=f"{label} ({len(runs)} runs)")
-            key = (sc, v.split("\n")[0], v.split("\n")[1] if "\n" in v else "")
+            ax.plot(grid, anees, color=f"C{i}", lw=1, label=f"{label(v, newline=False)} ({len(runs)} runs)")
+            key = (sc, v[0], v[1])
             if key in groups:
                 lo, hi = groups[key]
                 ax.axhline(lo, color=f"C{i}", ls="--", lw=0.8)

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <csignal>
 #include <chrono>
@@ -108,6 +109,12 @@ bool publish(const fs::path& from, const fs::path& to) {
   throw Error("cannot rename " + from.string() + " to " + to.string() + ": " + ec.message());
 }
 
+std::string seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3f", s);
+  return buf;
+}
+
 std::string jobYaml(const Campaign& c, const Job& job, const std::string& sequence, const JobOutcome& outcome,
                     const std::vector<StepRecord>& steps, const std::string& started) {
   YAML::Emitter out;
@@ -126,14 +133,14 @@ std::string jobYaml(const Campaign& c, const Job& job, const std::string& sequen
   out << YAML::Key << "cause" << YAML::Value << YAML::DoubleQuoted << outcome.cause;
   out << YAML::Key << "host" << YAML::Value << hostName();
   out << YAML::Key << "started" << YAML::Value << started;
-  out << YAML::Key << "wall_s" << YAML::Value << outcome.wall_s;
+  out << YAML::Key << "wall_s" << YAML::Value << seconds(outcome.wall_s);
   out << YAML::Key << "steps" << YAML::Value << YAML::BeginSeq;
   for (const auto& s : steps) {
     out << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << s.name;
     out << YAML::Key << "command" << YAML::Value << YAML::Flow << s.command;
     out << YAML::Key << "result" << YAML::Value << s.result;
-    out << YAML::Key << "wall_s" << YAML::Value << s.wall_s;
+    out << YAML::Key << "wall_s" << YAML::Value << seconds(s.wall_s);
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;

@@ -185,6 +185,33 @@ TEST(CampaignRunner, RunsResumesCachesSequencesAndRecordsFailures) {
   }
 }
 
+TEST(CampaignResults, CollectMergesJobsFromOtherResultFolders) {
+  // Two "nodes" without a shared file system each run half of the jobs.
+  test::TempDir dir;
+  io::writeFileAtomic(dir.file("c.yaml"), shellCampaign(dir));
+  const Campaign c = loadCampaign(dir.file("c.yaml"));
+  const auto jobs = expandJobs(c);
+  const std::vector<Job> first(jobs.begin(), jobs.begin() + 10), second(jobs.begin() + 10, jobs.end());
+  RunnerOptions o;
+  o.evio_binary = "/bin/true";
+  o.results = dir.file("node1");
+  runCampaign(c, first, o);
+  o.results = dir.file("node2");
+  runCampaign(c, second, o);
+  const CollectReport partial = collectResults(c, jobs, dir.file("merged"), {dir.file("node1")});
+  EXPECT_EQ(partial.merged, 10u);
+  EXPECT_EQ(partial.missing.size(), jobs.size() - 10);
+  const CollectReport all = collectResults(c, jobs, dir.file("merged"), {dir.file("node1"), dir.file("node2")});
+  EXPECT_EQ(all.merged, jobs.size() - 10);
+  EXPECT_TRUE(all.missing.empty());
+  EXPECT_EQ(all.done, jobs.size());
+  EXPECT_EQ(all.failed, 12u);  // method "broken"
+  // The merged summary equals one from a single run of everything.
+  o.results = dir.file("single");
+  runCampaign(c, jobs, o);
+  EXPECT_EQ(io::readFile(dir.file("merged/summary.csv")), summaryCsv(c, jobs, dir.file("single")));
+}
+
 TEST(CampaignRunner, RemovesStagingOfDeadProcessesOnly) {
   test::TempDir dir;
   io::writeFileAtomic(dir.file("c.yaml"), shellCampaign(dir));

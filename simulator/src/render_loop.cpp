@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <optional>
 
@@ -20,6 +21,8 @@ constexpr TimeNs kNever = std::numeric_limits<TimeNs>::max();
 
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+/// Process CPU time (all threads) since c0, s.
+double cpuSecondsSince(std::clock_t c0) { return static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC; }
 
 /// Velocity of a camera C rigidly mounted at T_B_C, in C, from the body's state:
 ///   ṗ_W_C = v_W + R_W_B (ω_B × p_B_C),  v_C = R_W_Cᵀ ṗ_W_C,  ω_C = R_B_Cᵀ ω_B.
@@ -211,15 +214,19 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
       const Pose T_W_E = state.T_W_B * T_B_E;
       const CameraVelocity velocity = cameraVelocity(state, T_B_E);
       auto t0 = Clock::now();
+      std::clock_t c0 = std::clock();
       last = renderer.render(T_W_E, &velocity);
       stats->render_s += secondsSince(t0);
+      stats->render_cpu_s += cpuSecondsSince(c0);
       ++stats->renders;
 
       t0 = Clock::now();
+      c0 = std::clock();
       batch.clear();
       labels.clear();
       events_cam.update(t, last.radiance, &batch, &labels);
       stats->event_s += secondsSince(t0);
+      stats->event_cpu_s += cpuSecondsSince(c0);
 
       t0 = Clock::now();
       writer.appendEvents(batch, labels);

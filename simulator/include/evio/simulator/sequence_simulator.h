@@ -68,6 +68,8 @@ struct SimulationStats {
   double schedule_s = 0.0;           ///< adaptive step prediction
   double frame_s = 0.0;              ///< FrameCamera::capture
   double write_s = 0.0;              ///< writing events, frames, depth
+  double render_cpu_s = 0.0;         ///< CPU time (all threads) of the event-camera renders
+  double event_cpu_s = 0.0;          ///< CPU time (all threads) of EventCamera::update
   double truth_s = 0.0;              ///< ground truth, IMU, range, tracks passes
   int width = 0, height = 0;         ///< event sensor, px
   std::uint64_t renders = 0;         ///< event-camera renders

@@ -64,9 +64,12 @@ void PipelineOptions::validate() const {
   if (method == "eklt-vio")
     requireField(frontend.tracker == "eklt", "frontend.tracker",
                  "must be eklt for method eklt-vio (got '" + frontend.tracker + "')");
-  if (method == "klt-vio")
+  if (method == "klt-vio") {
     requireField(frontend.tracker == "klt", "frontend.tracker",
                  "must be klt for method klt-vio (got '" + frontend.tracker + "')");
+    requireField(sync.trigger != "events", "sync.trigger",
+                 "must be track_time or fixed_rate for method klt-vio (KLT reads no events)");
+  }
 }
 
 PipelineOptions PipelineOptions::forMethod(std::string_view method) {

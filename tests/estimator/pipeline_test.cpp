@@ -1,0 +1,283 @@
+// The estimator pipeline end to end on tiny sequence folders
+// (support/tiny_sequence.h): the backend on exact ground-truth tracks with
+// pixel noise (method tracks), the estimate folder it writes, determinism,
+// calib.txt-only folders, and every kind of bad input (an evio::Error with
+// one clear message, or a status — never a crash).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "evio/core/io/atomic_file.h"
+#include "evio/core/io/config.h"
+#include "evio/core/io/events_h5.h"
+#include "evio/core/io/imu_state_txt.h"
+#include "evio/core/io/status_yaml.h"
+#include "evio/core/io/timing_txt.h"
+#include "evio/core/io/tum.h"
+#include "evio/estimator/pipeline/groundtruth_init.h"
+#include "evio/estimator/pipeline/pipeline.h"
+#include "temp_dir.h"
+#include "support/tiny_sequence.h"
+
+namespace evio::estimator {
+namespace {
+
+namespace fs = std::filesystem;
+
+PipelineOptions tracksOptions(double noise_px = 0.5) {
+  PipelineOptions o = PipelineOptions::forMethod("tracks");
+  o.tracks.noise_px = noise_px;
+  o.backend.sigma_img_px = 1.0;
+  o.backend.slam_min_depth_m = 1.5;  // the landmarks are 2-5 m away
+  return o;
+}
+
+/// Largest position error of the estimate against the ground truth (m), after `skip_s`.
+double maxPositionError(const std::string& estimate, const std::string& groundtruth, double skip_s = 0.0) {
+  const Trajectory est = io::readTum(estimate);
+  const Trajectory gt = io::readTum(groundtruth);
+  double worst = 0.0;
+  for (const auto& p : est) {
+    if (p.t_ns < gt.front().t_ns + secondsToNs(skip_s) || p.t_ns > gt.back().t_ns) continue;
+    worst = std::max(worst, (p.pose.translation() - interpolatePose(gt, p.t_ns).translation()).norm());
+  }
+  return worst;
+}
+
+void expectErrorContaining(const std::function<void()>& fn, const std::vector<std::string>& needles) {
+  try {
+    fn();
+  } catch (const Error& e) {
+    for (const auto& n : needles) EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what();
+    return;
+  }
+  ADD_FAILURE() << "no evio::Error";
+}
+
+// --- end to end on ground-truth tracks -------------------------------------------------------
+
+TEST(Pipeline, TracksMethodFollowsTheGroundTruthAndWritesTheEstimateFolder) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq"), out = dir.file("out");
+  test::TinySequenceOptions so;
+  writeTinySequence(seq, so);
+  const PipelineOptions options = tracksOptions();
+  const PipelineResult r = runPipeline(seq, options, out);
+
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  ASSERT_TRUE(r.initialization_t_ns.has_value());
+  EXPECT_EQ(*r.initialization_t_ns, 0);
+  EXPECT_EQ(r.measurement_sets, 80u);  // 20 Hz over 4 s
+  EXPECT_EQ(r.poses, 80u);
+  EXPECT_GT(r.backend.slam_initialized_prior + r.backend.slam_initialized_triangulated, 0);
+  // Initialised from ground truth, the estimate stays within 5 cm over 4 s
+  // (0.5 px noise, six_dof motion of a few cm and degrees).
+  EXPECT_LT(maxPositionError(out + "/trajectory.txt", seq + "/groundtruth.txt"), 0.05);
+
+  // Every file is there and reads back through core/io.
+  const Trajectory traj = io::readTum(out + "/trajectory.txt");
+  const auto cov = io::readTumCovariance(out + "/trajectory_covariance.txt");  // validates PSD
+  ASSERT_EQ(cov.size(), traj.size());
+  for (std::size_t k = 0; k < traj.size(); ++k) {
+    EXPECT_EQ(cov[k].t_ns, traj[k].t_ns);
+    EXPECT_GT(cov[k].cov_orientation.trace(), 0.0);
+  }
+  EXPECT_EQ(io::readImuStateText(out + "/imu_state.txt").size(), traj.size());
+  const auto timing = io::readTimingText(out + "/timing.txt");
+  ASSERT_GE(timing.size(), 2u);
+  EXPECT_EQ(timing.front().t_ns, 0);                        // written at initialisation
+  EXPECT_GE(timing.back().t_ns, secondsToNs(3.9));          // up to the end
+  const io::EstimateStatus status = io::readStatusYaml(out + "/status.yaml");
+  EXPECT_TRUE(status.ok());
+  EXPECT_EQ(status.initialization_t_ns, std::optional<TimeNs>(0));
+  PipelineOptions back;
+  config::fill(config::loadFile(out + "/config.yaml"), "", back);
+  EXPECT_TRUE(config::equal(back, options));
+  EXPECT_TRUE(fs::exists(out + "/summary.yaml"));
+}
+
+TEST(Pipeline, SameInputSameSeedGivesIdenticalTrajectories) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 2.0;
+  writeTinySequence(seq, so);
+  runPipeline(seq, tracksOptions(), dir.file("a"));
+  runPipeline(seq, tracksOptions(), dir.file("b"));
+  EXPECT_EQ(io::readFile(dir.file("a/trajectory.txt")), io::readFile(dir.file("b/trajectory.txt")));
+  EXPECT_EQ(io::readFile(dir.file("a/trajectory_covariance.txt")), io::readFile(dir.file("b/trajectory_covariance.txt")));
+  PipelineOptions other = tracksOptions();
+  other.seed = 2;  // other track noise
+  runPipeline(seq, other, dir.file("c"));
+  EXPECT_NE(io::readFile(dir.file("a/trajectory.txt")), io::readFile(dir.file("c/trajectory.txt")));
+}
+
+TEST(Pipeline, CalibTxtFolderTakesTheRestFromTheConfiguration) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.sensors_yaml = false;
+  so.duration_s = 2.0;
+  writeTinySequence(seq, so);
+  PipelineOptions o = tracksOptions();
+  // Without frames the size must come from the configuration.
+  expectErrorContaining([&] { runPipeline(seq, o, dir.file("out0")); }, {"calibration.width"});
+  o.calibration.width = 240;
+  o.calibration.height = 180;
+  o.calibration.T_B_C = test::tinyT_B_C().matrix();
+  const PipelineResult r = runPipeline(seq, o, dir.file("out"));
+  EXPECT_EQ(r.rig_source, "calib.txt");
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  EXPECT_LT(maxPositionError(dir.file("out/trajectory.txt"), seq + "/groundtruth.txt"), 0.05);
+}
+
+// --- IMU gaps (documented degraded mode) --------------------------------------------------------
+
+TEST(PipelineBadInput, ShortImuGapIsBridgedAndCounted) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  so.imu_gaps_s = {{1.5, 1.7}};  // 0.2 s: above imu_max_gap_s (0.05), below imu_fail_gap_s (1)
+  writeTinySequence(seq, so);
+  const PipelineResult r = runPipeline(seq, tracksOptions(), dir.file("out"));
+  EXPECT_TRUE(r.status.ok()) << r.status.cause;
+  EXPECT_EQ(r.backend.imu_gaps, 1);
+  EXPECT_GE(io::readTum(dir.file("out/trajectory.txt")).back().t_ns, secondsToNs(2.9));
+}
+
+TEST(PipelineBadInput, LongImuGapFailsWithItsTimeAndKeepsTheTrajectoryBeforeIt) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 4.0;
+  so.imu_gaps_s = {{1.5, 3.0}};
+  writeTinySequence(seq, so);
+  const PipelineResult r = runPipeline(seq, tracksOptions(), dir.file("out"));
+  EXPECT_EQ(r.status.code, io::EstimateStatus::Code::kFailed);
+  EXPECT_NE(r.status.cause.find("IMU gap"), std::string::npos) << r.status.cause;
+  ASSERT_TRUE(r.status.t_ns.has_value());
+  EXPECT_NEAR(nsToSeconds(*r.status.t_ns), 1.5, 0.11);  // the filter lags the IMU by at most max_delay_s
+  const io::EstimateStatus written = io::readStatusYaml(dir.file("out/status.yaml"));
+  EXPECT_EQ(written, r.status);
+  const Trajectory traj = io::readTum(dir.file("out/trajectory.txt"));
+  ASSERT_FALSE(traj.empty());
+  EXPECT_LT(traj.back().t_ns, secondsToNs(1.5));
+}
+
+TEST(PipelineBadInput, ImuEndingWhileFramesContinueFails) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  so.frames = 60;
+  so.imu_end_s = 1.0;
+  writeTinySequence(seq, so);
+  const PipelineResult r = runPipeline(seq, PipelineOptions::forMethod("klt-vio"), dir.file("out"));
+  EXPECT_EQ(r.status.code, io::EstimateStatus::Code::kFailed);
+  EXPECT_NE(r.status.cause.find("no IMU reading after"), std::string::npos) << r.status.cause;
+}
+
+// --- other bad input: one clear evio::Error ------------------------------------------------------
+
+TEST(PipelineBadInput, EventsOutOfOrderNameTheFileAndLine) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 1.0;
+  so.frames = 10;
+  writeTinySequence(seq, so);
+  io::writeFileAtomic(seq + "/events.txt", "0.001 10 10 1\n0.002 11 10 0\n0.0015 12 10 1\n0.003 13 10 1\n");
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+                        {"events.txt:3"});
+  EXPECT_FALSE(fs::exists(dir.file("out/trajectory.txt")));  // nothing half-written
+}
+
+TEST(PipelineBadInput, NoFramesForFrameBasedTrackingSaysWhatToDo) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 1.0;
+  so.events = true;
+  writeTinySequence(seq, so);
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+                        {"no frames", "frontend.image_source=reconstructed"});
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("klt-vio"), dir.file("out")); },
+                        {"no frames", "KLT-VIO needs frames"});
+  // The documented alternative runs.
+  PipelineOptions o = PipelineOptions::forMethod("eklt-vio");
+  o.frontend.image_source = "reconstructed";
+  EXPECT_NO_THROW(runPipeline(seq, o, dir.file("out")));
+}
+
+TEST(PipelineBadInput, FrameSizeNotTheCalibrationsNamesBoth) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 1.0;
+  so.frames = 5;
+  so.frame_width = 200;
+  so.frame_height = 150;
+  so.events = true;
+  writeTinySequence(seq, so);
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("klt-vio"), dir.file("out")); },
+                        {"200x150", "240x180", "sensors.yaml camera frames"});
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+                        {"200x150", "240x180", "sensors.yaml camera cam0"});
+}
+
+TEST(PipelineBadInput, EventSensorSizeNotTheCalibrationsNamesBoth) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 1.0;
+  so.frames = 5;
+  writeTinySequence(seq, so);
+  EventArray events;
+  events.push_back(1000, 300, 10, true);
+  io::EventH5Options h5;
+  h5.width = 346;
+  h5.height = 260;
+  io::writeEventsH5(seq + "/events.h5", events, h5);
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+                        {"events.h5", "346x260", "240x180"});
+  // events.txt with a pixel outside the calibrated sensor.
+  fs::remove(seq + "/events.h5");
+  io::writeFileAtomic(seq + "/events.txt", "0.001 10 10 1\n0.002 300 10 0\n");
+  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+                        {"events.txt:2", "240x180"});
+}
+
+TEST(PipelineBadInput, InitialisationNeedsGroundTruthOrStaticMode) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 2.0;
+  so.groundtruth = false;
+  writeTinySequence(seq, so);
+  expectErrorContaining([&] { runPipeline(seq, tracksOptions(), dir.file("out")); },
+                        {"no groundtruth.txt", "init.mode=static"});
+  // auto → static; the hand-held motion is never still, so the run ends "failed" (not initialised).
+  PipelineOptions o = tracksOptions();
+  o.init.mode = "auto";
+  const PipelineResult r = runPipeline(seq, o, dir.file("out"));
+  EXPECT_EQ(r.status.code, io::EstimateStatus::Code::kFailed);
+  EXPECT_NE(r.status.cause.find("never initialised"), std::string::npos) << r.status.cause;
+  EXPECT_EQ(r.poses, 0u);
+}
+
+TEST(PipelineBadInput, MissingFolderOrCalibrationIsAnError) {
+  test::TempDir dir;
+  expectErrorContaining([&] { runPipeline(dir.file("nope"), tracksOptions(), dir.file("out")); }, {"not a folder"});
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 1.0;
+  writeTinySequence(seq, so);
+  fs::remove(seq + "/sensors.yaml");
+  expectErrorContaining([&] { runPipeline(seq, tracksOptions(), dir.file("out")); },
+                        {"neither sensors.yaml nor calib.txt"});
+}
+
+}  // namespace
+}  // namespace evio::estimator

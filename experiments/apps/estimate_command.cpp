@@ -91,10 +91,10 @@ void addEstimateCommand(CLI::App& app) {
                 static_cast<unsigned long long>(result.frames), static_cast<unsigned long long>(result.imu_samples),
                 static_cast<unsigned long long>(result.measurement_sets));
     const auto& t = result.times;
-    std::printf("wall %.2f s for %.2f s of data (overall RTF %.2f): read %.2f, frontend %.2f, backend %.2f, "
-                "output %.2f, setup %.2f s\n",
-                t.total_s, data_s, data_s > 0 ? t.total_s / data_s : 0.0, t.read_s, t.frontend_s, t.backend_s,
-                t.output_s, t.setup_s);
+    std::printf("wall %.2f s (CPU %.2f s) for %.2f s of data (overall RTF %.2f wall, %.2f CPU): read %.2f, "
+                "frontend %.2f, backend %.2f, output %.2f, setup %.2f s wall\n",
+                t.total_s, t.cpu_s, data_s, data_s > 0 ? t.total_s / data_s : 0.0, data_s > 0 ? t.cpu_s / data_s : 0.0,
+                t.read_s, t.frontend_s, t.backend_s, t.output_s, t.setup_s);
     for (const auto& n : result.notes) std::printf("note: %s\n", n.c_str());
     std::printf("wrote %s\n", args->output.c_str());
   });

@@ -49,7 +49,11 @@ void TracksInputOptions::validate() const {
   requirePositive("max_gap_s", max_gap_s);
 }
 
-void PipelineOutputOptions::validate() const { requirePositive("timing_interval_s", timing_interval_s); }
+void PipelineOutputOptions::validate() const {
+  requirePositive("timing_interval_s", timing_interval_s);
+  requireField(timing_clock == "wall" || timing_clock == "cpu", "timing_clock",
+               "must be wall or cpu (got '" + timing_clock + "')");
+}
 
 void PipelineOptions::validate() const {
   requireField(method == "eklt-vio" || method == "klt-vio" || method == "tracks", "method",

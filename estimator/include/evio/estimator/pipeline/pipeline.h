@@ -66,6 +66,7 @@ struct PipelineStageTimes {
   double backend_s = 0.0;   ///< EKF propagation and updates
   double output_s = 0.0;    ///< writing the estimate files
   double total_s = 0.0;     ///< the whole run
+  double cpu_s = 0.0;       ///< CPU time of the process over the whole run (std::clock, all threads)
 
   template <class V>
   void fields(V& v) {
@@ -75,6 +76,7 @@ struct PipelineStageTimes {
     v("backend_s", backend_s, "EKF propagation and updates, s");
     v("output_s", output_s, "writing the estimate files, s");
     v("total_s", total_s, "the whole run, s");
+    v("cpu_s", cpu_s, "CPU time of the process over the whole run, s");
   }
 };
 

@@ -116,6 +116,10 @@ struct PipelineOutputOptions {
   bool covariance = true;          ///< trajectory_covariance.txt
   bool imu_state = true;           ///< imu_state.txt (p, q, v, biases of B)
   double timing_interval_s = 0.1;  ///< a timing.txt line at least this often (data time), s
+  /// Clock of timing.txt's processing_s: `wall` (steady clock, what timing.txt
+  /// specifies) or `cpu` (CPU time of the process, all threads: std::clock),
+  /// which a machine shared with other work does not inflate.
+  std::string timing_clock = "wall";
   /// Stop reading input once the filter diverged or failed (the outputs end there).
   bool stop_on_divergence = true;
 
@@ -124,6 +128,7 @@ struct PipelineOutputOptions {
     v("covariance", covariance, "write trajectory_covariance.txt");
     v("imu_state", imu_state, "write imu_state.txt");
     v("timing_interval_s", timing_interval_s, "timing.txt line interval, s of data time");
+    v("timing_clock", timing_clock, "wall or cpu: the clock of timing.txt");
     v("stop_on_divergence", stop_on_divergence, "stop at divergence or failure");
   }
   void validate() const;

@@ -1,0 +1,168 @@
+#pragma once
+/// @file backend_options.h
+/// Parameters of the xVIO-style EKF backend with the reference defaults of
+/// ALGORITHMS.md (xVIO backend; DAVIS240 IMU noise) and the paper (M = 10,
+/// N = 15), and the sensors the backend needs (from sensors.yaml).
+
+#include <optional>
+#include <string_view>
+
+#include "evio/core/camera/camera.h"
+#include "evio/core/options.h"
+#include "evio/core/pose.h"
+#include "evio/core/sensor_rig.h"
+#include "evio/estimator/backend/imu_propagation.h"
+
+namespace evio::estimator {
+
+struct BackendOptions {
+  // Sliding window and features -----------------------------------------------
+  int window_size = 10;        ///< M: camera poses in the sliding window
+  int max_slam_features = 15;  ///< N: SLAM features in the state
+  /// Image measurement noise σ_img in pixels, converted to normalised units by
+  /// the mean focal length (σ_img / f). xVIO's 0.025 normalised ≈ 5 px at f ≈ 200 px.
+  double sigma_img_px = 5.0;
+
+  // IMU -------------------------------------------------------------------------
+  /// Take the IMU noise densities from the rig (sensors.yaml) instead of the fields below.
+  bool use_rig_imu_noise = true;
+  double accelerometer_noise_density = 0.004316;  ///< σ_a, m/s²/√Hz (DAVIS240 reference)
+  double accelerometer_random_walk = 0.0004316;   ///< σ_ba, m/s³/√Hz
+  double gyroscope_noise_density = 0.0002;        ///< σ_g, rad/s/√Hz
+  double gyroscope_random_walk = 0.00002;         ///< σ_bg, rad/s²/√Hz
+  /// IMU outlier bound: a reading with ‖acc‖ above this (or non-finite) is
+  /// replaced by the previous reading, m/s².
+  double imu_max_acc_mps2 = 100.0;
+  /// Gaps between IMU readings longer than this are counted (bridged by linear interpolation), s.
+  double imu_max_gap_s = 0.05;
+  /// A gap longer than this sets the status to failed, s.
+  double imu_fail_gap_s = 1.0;
+
+  // Initial uncertainty (ALGORITHMS.md) ------------------------------------------
+  double initial_sigma_p_m = 0.0;          ///< position (0: exactly known; stored as 1e-12 m²)
+  double initial_sigma_v_mps = 0.05;       ///< velocity, m/s
+  double initial_sigma_theta_deg = 3.0;    ///< attitude, deg (all three axes)
+  double initial_sigma_bg_degps = 6.0;     ///< gyroscope bias, deg/s
+  double initial_sigma_ba_mps2 = 0.3;      ///< accelerometer bias, m/s²
+
+  // SLAM features -----------------------------------------------------------------
+  /// d_min: the depth prior is ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min)
+  /// (reference ρ0 = 1.3, σ 0.65 ⇔ d_min = 0.3846 m).
+  double slam_min_depth_m = 0.3846;
+  int slam_min_track_length = 10;          ///< observations before a track may become SLAM
+  double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
+  int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature
+  bool slam_triangulated_init = true;      ///< initialise from triangulation when the parallax test passes
+
+  // MSCKF features ----------------------------------------------------------------
+  /// Also use tracks lost before spanning the window (xVIO drops them).
+  bool msckf_use_lost_tracks = false;
+  int msckf_min_track_length = 3;          ///< fewer observations: not used (>= 2)
+  double min_parallax_px = 30.0;           ///< rotation-compensated disparity for triangulation, px
+  double msckf_gate_probability = 0.95;    ///< χ² gate of MSCKF features
+  int triangulation_max_iterations = 10;   ///< Gauss–Newton iterations
+  double triangulation_tolerance = 1e-5;   ///< relative step that ends Gauss–Newton
+  double triangulation_min_depth_m = 0.05; ///< nearer triangulated points are rejected, m
+
+  // Update -------------------------------------------------------------------------
+  bool joseph_form = true;  ///< Joseph-form covariance update (else P − K S Kᵀ, symmetrised)
+  /// Observability constraint (our addition, not in xVIO): the IMU transition
+  /// is evaluated at the state before the updates (first-estimate Jacobians,
+  /// Huang et al. 2010) and every measurement Jacobian is projected onto the
+  /// complement of the unobservable global-yaw direction (observability-
+  /// constrained EKF, Hesch et al. 2014), so the filter gains no spurious yaw
+  /// information and stays consistent in rotation-only motion and hover.
+  bool observability_constraint = true;
+  /// Iterations of the visual update (1: EKF; more: iterated EKF re-linearising
+  /// the SLAM observations, xVIO's iekf_iter).
+  int iekf_iterations = 1;
+
+  // Timing ---------------------------------------------------------------------------
+  /// The filter state is kept at most this far behind the newest IMU reading;
+  /// measurements may arrive this late, s.
+  double max_delay_s = 0.1;
+  /// A measurement older than the filter state by at most this is applied at
+  /// the filter state (the nearest buffered state); older ones are dropped, s.
+  double max_late_s = 0.005;
+
+  // Divergence ------------------------------------------------------------------------
+  double max_velocity_mps = 100.0;  ///< a faster velocity estimate means divergence, m/s
+
+  // Optional updates -------------------------------------------------------------------
+  /// Range-finder noise σ, m (0: the rig's noise_sigma_m).
+  double range_sigma_m = 0.0;
+  /// SLAM features whose ray is within this angle of the range beam define
+  /// the terrain plane (at least 3 are needed), deg.
+  double range_max_feature_angle_deg = 15.0;
+  double zero_velocity_sigma_mps = 0.01;  ///< zero-velocity update noise σ, m/s
+
+  // Static initialisation -----------------------------------------------------------------
+  double static_window_s = 1.0;             ///< still IMU needed, s
+  double static_max_acc_std_mps2 = 0.1;     ///< per-axis std of acc within the window, m/s²
+  double static_max_gyro_std_radps = 0.02;  ///< per-axis std of gyro within the window, rad/s
+
+  template <class V>
+  void fields(V& v) {
+    v("window_size", window_size, "M: camera poses in the sliding window");
+    v("max_slam_features", max_slam_features, "N: SLAM features in the state");
+    v("sigma_img_px", sigma_img_px, "image measurement noise, px");
+    v("use_rig_imu_noise", use_rig_imu_noise, "IMU noise from sensors.yaml");
+    v("accelerometer_noise_density", accelerometer_noise_density, "m/s^2/sqrt(Hz)");
+    v("accelerometer_random_walk", accelerometer_random_walk, "m/s^3/sqrt(Hz)");
+    v("gyroscope_noise_density", gyroscope_noise_density, "rad/s/sqrt(Hz)");
+    v("gyroscope_random_walk", gyroscope_random_walk, "rad/s^2/sqrt(Hz)");
+    v("imu_max_acc_mps2", imu_max_acc_mps2, "IMU outlier bound on |acc|, m/s^2");
+    v("imu_max_gap_s", imu_max_gap_s, "IMU gaps counted above, s");
+    v("imu_fail_gap_s", imu_fail_gap_s, "IMU gap that fails the filter, s");
+    v("initial_sigma_p_m", initial_sigma_p_m, "initial position sigma, m");
+    v("initial_sigma_v_mps", initial_sigma_v_mps, "initial velocity sigma, m/s");
+    v("initial_sigma_theta_deg", initial_sigma_theta_deg, "initial attitude sigma, deg");
+    v("initial_sigma_bg_degps", initial_sigma_bg_degps, "initial gyro bias sigma, deg/s");
+    v("initial_sigma_ba_mps2", initial_sigma_ba_mps2, "initial accel bias sigma, m/s^2");
+    v("slam_min_depth_m", slam_min_depth_m, "d_min of the depth prior, m");
+    v("slam_min_track_length", slam_min_track_length, "observations before SLAM");
+    v("slam_gate_probability", slam_gate_probability, "SLAM Mahalanobis gate probability");
+    v("slam_max_gate_failures", slam_max_gate_failures, "gate failures removing a SLAM feature");
+    v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
+    v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
+    v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");
+    v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for triangulation, px");
+    v("msckf_gate_probability", msckf_gate_probability, "MSCKF chi2 gate probability");
+    v("triangulation_max_iterations", triangulation_max_iterations, "Gauss-Newton iterations");
+    v("triangulation_tolerance", triangulation_tolerance, "relative Gauss-Newton step tolerance");
+    v("triangulation_min_depth_m", triangulation_min_depth_m, "nearest triangulated depth, m");
+    v("joseph_form", joseph_form, "Joseph-form covariance update");
+    v("observability_constraint", observability_constraint, "keep global yaw unobservable (FEJ transition, OC updates)");
+    v("iekf_iterations", iekf_iterations, "iterations of the visual update (1: EKF)");
+    v("max_delay_s", max_delay_s, "filter lag behind the newest IMU reading, s");
+    v("max_late_s", max_late_s, "late measurements applied at the filter state, s");
+    v("max_velocity_mps", max_velocity_mps, "velocity bound for divergence, m/s");
+    v("range_sigma_m", range_sigma_m, "range noise, m (0: rig)");
+    v("range_max_feature_angle_deg", range_max_feature_angle_deg, "features near the beam, deg");
+    v("zero_velocity_sigma_mps", zero_velocity_sigma_mps, "zero-velocity noise, m/s");
+    v("static_window_s", static_window_s, "still IMU window, s");
+    v("static_max_acc_std_mps2", static_max_acc_std_mps2, "stillness bound on acc std, m/s^2");
+    v("static_max_gyro_std_radps", static_max_gyro_std_radps, "stillness bound on gyro std, rad/s");
+  }
+  /// Throws evio::Error naming the field.
+  void validate() const;
+
+  /// The IMU noise densities to use: the rig's when use_rig_imu_noise, else the fields.
+  ImuNoiseDensities imuNoise(const ImuSensor& rig_imu) const;
+};
+
+/// What the backend needs to know about the sensors.
+struct BackendSensors {
+  Camera camera;                                   ///< the camera the measurements come from
+  Pose T_B_C;                                      ///< camera into body (IMU) frame
+  double gravity_mps2 = 9.81;                      ///< magnitude of gravity, along −z of W
+  ImuSensor imu;                                   ///< noise densities (Kalibr names)
+  std::optional<RangeFinderSensor> range_finder;   ///< when the rig has one
+  TimeNs time_offset_cam_imu_ns = 0;               ///< t_imu = t_cam + offset
+
+  /// From a rig: the camera named `camera_name`, or the first event camera
+  /// (else the first camera) when empty. Throws evio::Error for an unknown name.
+  static BackendSensors fromRig(const SensorRig& rig, std::string_view camera_name = "");
+};
+
+}  // namespace evio::estimator

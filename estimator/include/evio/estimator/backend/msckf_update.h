@@ -1,0 +1,38 @@
+#pragma once
+/// @file msckf_update.h
+/// The MSCKF measurement of one feature track (Mourikis & Roumeliotis 2007;
+/// ALGORITHMS.md, MSCKF features): triangulate the point p_W from the track's
+/// observations in the window (triangulation.h), linearise all observations,
+///   r = z − π(R_iᵀ (p̂_W − p_i)) ≈ H_x δx + H_f δp_W + n,
+/// and project on the left null space of H_f (ekf_update.h) so that the
+/// 2n − 3 residuals r_o = Q2ᵀ r constrain the clone poses only.
+
+#include <vector>
+
+#include "evio/core/eigen_types.h"
+#include "evio/estimator/backend/feature_track.h"
+#include "evio/estimator/backend/filter_state.h"
+#include "evio/estimator/backend/triangulation.h"
+
+namespace evio::estimator {
+
+enum class MsckfOutcome { kOk, kTooShort, kNoParallax, kTriangulationFailed, kProjectionFailed };
+
+struct MsckfResidual {
+  MatX H;               ///< (2n − 3) × dim, null-space projected
+  VecX r;               ///< 2n − 3
+  Vec3 p_W = Vec3::Zero();  ///< the triangulated point
+};
+
+/// The clones, their positions in state.clones and the observations of a
+/// track whose clones are still in the window (observations of missing clones
+/// are skipped).
+void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vector<CameraClone>* clones,
+                 std::vector<std::size_t>* clone_positions, std::vector<Vec2>* z);
+
+/// The null-space projected MSCKF residual of `track`. min_parallax is the
+/// rotation-compensated disparity (normalised units) the track must exceed.
+MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
+                           const TriangulationOptions& triangulation, MsckfResidual* out);
+
+}  // namespace evio::estimator

@@ -1,0 +1,31 @@
+#pragma once
+/// @file range_update.h
+/// Laser range-finder update (ALGORITHMS.md, Mars-helicopter extension; the
+/// xVIO range update): the beam from the range finder's origin o along its +z
+/// axis d meets the terrain plane through three SLAM features q1, q2, q3
+/// (those whose rays are nearest to the beam), and the predicted range is
+///   n = (q2 − q1) × (q3 − q1),   range = nᵀ (q1 − o) / (nᵀ d),
+///   o = p_W_B + R_W_B p_B_L,   d = R_W_B R_B_L e_z,
+/// with q_k = anchoredToWorld(anchor_k, f_k). It fixes the scale in hover.
+
+#include "evio/core/eigen_types.h"
+#include "evio/core/pose.h"
+#include "evio/estimator/backend/filter_state.h"
+
+namespace evio::estimator {
+
+/// Predicted range to the plane through q1, q2, q3 along the ray o + s d, with
+/// Jacobians with respect to o, d and the three points (each 1×3). False when
+/// the plane is (nearly) parallel to the beam or the triangle degenerate.
+bool rangeToPlane(const Vec3& o, const Vec3& d, const Vec3& q1, const Vec3& q2, const Vec3& q3, double* range,
+                  Eigen::Matrix<double, 1, 3>* d_r_d_o = nullptr, Eigen::Matrix<double, 1, 3>* d_r_d_d = nullptr,
+                  Eigen::Matrix<double, 1, 9>* d_r_d_q = nullptr);
+
+/// The range measurement of the state: residual r = measured − predicted and
+/// H (1 × dim), using the three SLAM features whose rays (from the range
+/// finder origin) are nearest to the beam, within max_angle_rad of it.
+/// False when fewer than three such features exist or the plane is degenerate.
+bool rangeResidual(const FilterState& state, const Pose& T_B_L, double measured_range_m, double max_angle_rad,
+                   Eigen::Matrix<double, 1, Eigen::Dynamic>* H, double* r);
+
+}  // namespace evio::estimator

@@ -1,0 +1,89 @@
+#pragma once
+/// @file slam_features.h
+/// SLAM features in anchored inverse depth (eklt-vio-paper.tex, Backend;
+/// ALGORITHMS.md, SLAM features): their measurement, their two ways into the
+/// state, and re-anchoring when the window slides.
+
+#include <cstddef>
+#include <functional>
+
+#include "evio/core/eigen_types.h"
+#include "evio/estimator/backend/feature_track.h"
+#include "evio/estimator/backend/filter_state.h"
+
+namespace evio::estimator {
+
+/// Residual r = z − π(h) of SLAM feature j observed at z in clone c (positions
+/// in state.features / state.clones) and its Jacobian H (2 × dim) over the
+/// anchor clone, the observing clone and the feature (visual_models.h).
+/// False when the feature is not in front of the clone.
+bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const Vec2& z,
+                  Eigen::Matrix<double, 2, Eigen::Dynamic>* H, Vec2* r);
+
+/// Depth-prior initialisation (Montiel et al. 2006; xVIO): anchor = clone c,
+/// (α, β) = z, ρ = rho0, with covariance diag(σ_z², σ_z², σ_ρ0²) and zero
+/// cross-covariance — the parameters are relative to the anchor clone, whose
+/// own error is in the state, so the new feature is independent of it.
+void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
+                             double sigma_rho0, double sigma_z);
+
+/// Result of the triangulated initialisation.
+enum class SlamInitOutcome { kOk, kDegenerate, kGateFailed, kUpdateFailed };
+
+/// Initialisation from a triangulated track (Li & Mourikis 2012, the "delayed"
+/// initialisation), anchored in the track's last clone with triangulated
+/// parameters abr. Stacking all observations, r ≈ H_x δx + H_f δf + n with the
+/// QR split H_f = [Q1 Q2][R1; 0]:
+///   Q1ᵀ r = Q1ᵀ H_x δx + R1 δf + Q1ᵀ n  ⇒ δf = R1⁻¹(Q1ᵀ r − H1 δx − n1), H1 = Q1ᵀ H_x,
+/// so the feature enters with mean abr + R1⁻¹ Q1ᵀ r, covariance
+///   P_ff = R1⁻¹ (H1 P H1ᵀ + σ² I) R1⁻ᵀ,  P_fx = −R1⁻¹ H1 P,
+/// and the rest (Q2ᵀ H_x, Q2ᵀ r) is an ordinary update, χ²-gated with threshold
+/// `chi2_threshold(dof)`. Needs at least 2 observations. `constrain(H)` is
+/// applied to H_x before the split (the backend's observability constraint;
+/// pass a no-op to disable).
+template <class Chi2, class Constrain>
+SlamInitOutcome addSlamFeatureTriangulated(FilterState& state, const FeatureTrack& track, const Vec3& abr,
+                                           double sigma2, bool joseph, const Chi2& chi2_threshold,
+                                           const Constrain& constrain);
+
+/// Re-anchors feature j onto clone `to` (positions in the state): the mean by
+/// reanchorFeature() and the covariance by P ← T P Tᵀ, T the identity with the
+/// feature's rows replaced by [∂f'/∂x_from, ∂f'/∂x_to, ∂f'/∂f]. The feature's
+/// world point and its covariance are unchanged. False (state unchanged) when
+/// the point is not in front of `to`. When `yaw_direction` is non-null (the
+/// backend's observability constraint), the rows of T are projected so that the
+/// feature gains no component along it (T n = n for the anchored parameters, whose
+/// own component is zero).
+bool reanchorSlamFeature(FilterState& state, std::size_t j, std::size_t to, const VecX* yaw_direction = nullptr);
+
+// --- implementation of the template ------------------------------------------------
+
+/// Non-template part of addSlamFeatureTriangulated: builds the feature's mean,
+/// P_ff, P_fx and the remaining update (H2, r2). False when degenerate.
+bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, const Vec3& abr, double sigma2,
+                           SlamFeature* f, Mat3* P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>* P_fx, MatX* H2,
+                           VecX* r2, const std::function<void(MatX*)>& constrain);
+double slamMahalanobis(const FilterState& state, const MatX& H, const VecX& r, double sigma2);
+bool slamUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph);
+
+template <class Chi2, class Constrain>
+SlamInitOutcome addSlamFeatureTriangulated(FilterState& state, const FeatureTrack& track, const Vec3& abr,
+                                           double sigma2, bool joseph, const Chi2& chi2_threshold,
+                                           const Constrain& constrain) {
+  SlamFeature f;
+  Mat3 P_ff;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> P_fx;
+  MatX H2;
+  VecX r2;
+  if (!splitTriangulatedInit(state, track, abr, sigma2, &f, &P_ff, &P_fx, &H2, &r2, constrain))
+    return SlamInitOutcome::kDegenerate;
+  if (r2.size() > 0 && slamMahalanobis(state, H2, r2, sigma2) > chi2_threshold(static_cast<int>(r2.size())))
+    return SlamInitOutcome::kGateFailed;
+  state.addFeature(f, P_ff, P_fx);
+  if (r2.size() == 0) return SlamInitOutcome::kOk;
+  H2.conservativeResize(Eigen::NoChange, state.dim());
+  H2.rightCols(3).setZero();
+  return slamUpdate(state, H2, r2, sigma2, joseph) ? SlamInitOutcome::kOk : SlamInitOutcome::kUpdateFailed;
+}
+
+}  // namespace evio::estimator

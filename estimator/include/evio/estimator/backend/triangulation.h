@@ -1,0 +1,49 @@
+#pragma once
+/// @file triangulation.h
+/// Triangulation of a feature from its observations in the sliding window
+/// (ALGORITHMS.md: Gauss–Newton in inverse depth, 10 iterations, tol 1e-5).
+///
+/// 1. Linear start: the point p minimising Σ_i ‖(I − b_i b_iᵀ)(p − p_i)‖²,
+///    b_i = R_i [z_i; 1]/‖·‖ the unit rays, p_i the clone positions.
+/// 2. Gauss–Newton on the anchored inverse-depth parameters (α, β, ρ) of the
+///    anchor clone, minimising Σ_i ‖z_i − π(h_i(α, β, ρ))‖² (visual_models.h),
+///    stopping when the step is below tolerance · ‖(α, β, ρ)‖.
+
+#include <vector>
+
+#include "evio/core/eigen_types.h"
+#include "evio/estimator/backend/filter_state.h"
+
+namespace evio::estimator {
+
+struct TriangulationOptions {
+  int max_iterations = 10;       ///< Gauss–Newton iterations
+  double tolerance = 1e-5;       ///< relative step size that ends the iteration
+  double min_depth_m = 0.05;     ///< nearer points (in any observing clone) are rejected
+  double max_depth_m = 1000.0;   ///< farther points (in the anchor) are rejected
+  /// Residual bound: the RMS reprojection error after convergence must be
+  /// below this, in normalised units (0: no bound).
+  double max_rms_residual = 0.0;
+};
+
+struct TriangulationResult {
+  Vec3 abr = Vec3::Zero();  ///< (α, β, ρ) in the anchor clone
+  Vec3 p_W = Vec3::Zero();  ///< the same point in W
+  int iterations = 0;
+  double rms_residual = 0.0;  ///< normalised units
+};
+
+/// Triangulates from observations z[i] in clones[i] (at least 2), anchored in
+/// clones[anchor]. Returns false (result unspecified) when the linear system is
+/// degenerate, the point is behind or too near/far, or GN diverges.
+bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
+                        std::size_t anchor, const TriangulationOptions& options, TriangulationResult* result);
+
+/// Rotation-compensated disparity of a track (ALGORITHMS.md parallax test):
+/// the largest distance, in normalised units, between the observation in the
+/// last clone and the rays of the other observations rotated into it,
+///   max_i ‖π(R_lastᵀ R_i [z_i; 1]) − z_last‖.
+/// Multiply by the focal length for pixels.
+double rotationCompensatedDisparity(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z);
+
+}  // namespace evio::estimator

@@ -1,0 +1,70 @@
+#include "evio/estimator/backend/backend_options.h"
+
+#include <string>
+
+#include "evio/core/error.h"
+
+namespace evio::estimator {
+
+void BackendOptions::validate() const {
+  requireField(window_size >= 2, "window_size", "must be >= 2");
+  requireField(max_slam_features >= 0, "max_slam_features", "must be >= 0");
+  requirePositive("sigma_img_px", sigma_img_px);
+  requireNonNegative("accelerometer_noise_density", accelerometer_noise_density);
+  requireNonNegative("accelerometer_random_walk", accelerometer_random_walk);
+  requireNonNegative("gyroscope_noise_density", gyroscope_noise_density);
+  requireNonNegative("gyroscope_random_walk", gyroscope_random_walk);
+  requirePositive("imu_max_acc_mps2", imu_max_acc_mps2);
+  requirePositive("imu_max_gap_s", imu_max_gap_s);
+  requireField(imu_fail_gap_s >= imu_max_gap_s, "imu_fail_gap_s", "must be >= imu_max_gap_s");
+  requireNonNegative("initial_sigma_p_m", initial_sigma_p_m);
+  requireNonNegative("initial_sigma_v_mps", initial_sigma_v_mps);
+  requireNonNegative("initial_sigma_theta_deg", initial_sigma_theta_deg);
+  requireNonNegative("initial_sigma_bg_degps", initial_sigma_bg_degps);
+  requireNonNegative("initial_sigma_ba_mps2", initial_sigma_ba_mps2);
+  requirePositive("slam_min_depth_m", slam_min_depth_m);
+  requireField(slam_min_track_length >= 1, "slam_min_track_length", "must be >= 1");
+  requireField(slam_gate_probability > 0.0 && slam_gate_probability < 1.0, "slam_gate_probability",
+               "must be in (0, 1)");
+  requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");
+  requireField(msckf_min_track_length >= 2, "msckf_min_track_length", "must be >= 2");
+  requireNonNegative("min_parallax_px", min_parallax_px);
+  requireField(msckf_gate_probability > 0.0 && msckf_gate_probability < 1.0, "msckf_gate_probability",
+               "must be in (0, 1)");
+  requireField(triangulation_max_iterations >= 1, "triangulation_max_iterations", "must be >= 1");
+  requirePositive("triangulation_tolerance", triangulation_tolerance);
+  requirePositive("triangulation_min_depth_m", triangulation_min_depth_m);
+  requireField(iekf_iterations >= 1, "iekf_iterations", "must be >= 1");
+  requireNonNegative("max_delay_s", max_delay_s);
+  requireNonNegative("max_late_s", max_late_s);
+  requirePositive("max_velocity_mps", max_velocity_mps);
+  requireNonNegative("range_sigma_m", range_sigma_m);
+  requireInRange("range_max_feature_angle_deg", range_max_feature_angle_deg, 0.0, 90.0);
+  requirePositive("zero_velocity_sigma_mps", zero_velocity_sigma_mps);
+  requirePositive("static_window_s", static_window_s);
+  requirePositive("static_max_acc_std_mps2", static_max_acc_std_mps2);
+  requirePositive("static_max_gyro_std_radps", static_max_gyro_std_radps);
+}
+
+ImuNoiseDensities BackendOptions::imuNoise(const ImuSensor& rig_imu) const {
+  if (use_rig_imu_noise)
+    return {rig_imu.accelerometer_noise_density, rig_imu.accelerometer_random_walk,
+            rig_imu.gyroscope_noise_density, rig_imu.gyroscope_random_walk};
+  return {accelerometer_noise_density, accelerometer_random_walk, gyroscope_noise_density, gyroscope_random_walk};
+}
+
+BackendSensors BackendSensors::fromRig(const SensorRig& rig, std::string_view camera_name) {
+  const CameraSensor* cam = nullptr;
+  if (!camera_name.empty()) {
+    cam = rig.findCamera(camera_name);
+    if (cam == nullptr) throw Error("backend: camera '" + std::string(camera_name) + "' is not in the rig");
+  } else {
+    cam = rig.firstCamera(CameraRole::kEvent);
+    if (cam == nullptr && !rig.cameras.empty()) cam = &rig.cameras.front();
+    if (cam == nullptr) throw Error("backend: the rig has no camera");
+  }
+  BackendSensors s{cam->camera, cam->T_B_C, rig.gravity_m_s2, rig.imu, rig.range_finder, rig.time_offset_cam_imu_ns};
+  return s;
+}
+
+}  // namespace evio::estimator

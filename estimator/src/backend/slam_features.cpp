@@ -1,0 +1,129 @@
+#include "evio/estimator/backend/slam_features.h"
+
+#include <Eigen/QR>
+
+#include "evio/estimator/backend/ekf_update.h"
+#include "evio/estimator/backend/visual_models.h"
+
+namespace evio::estimator {
+
+bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const Vec2& z,
+                  Eigen::Matrix<double, 2, Eigen::Dynamic>* H, Vec2* r) {
+  const SlamFeature& f = state.features[j];
+  const int a = state.findClone(f.anchor_clone_id);
+  if (a < 0) return false;
+  const CameraClone& anchor = state.clones[static_cast<std::size_t>(a)];
+  Vec2 zh;
+  Mat26 Ha, Hc;
+  Mat23 Hf;
+  if (!projectAnchoredFeature(anchor, state.clones[c], f.abr, &zh, &Ha, &Hc, &Hf)) return false;
+  H->setZero(2, state.dim());
+  H->block<2, 6>(0, state.cloneIndex(static_cast<std::size_t>(a))) += Ha;
+  H->block<2, 6>(0, state.cloneIndex(c)) += Hc;
+  H->block<2, 3>(0, state.featureIndex(j)) = Hf;
+  *r = z - zh;
+  return true;
+}
+
+void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
+                             double sigma_rho0, double sigma_z) {
+  SlamFeature f;
+  f.id = id;
+  f.anchor_clone_id = state.clones[c].id;
+  f.abr = Vec3(z.x(), z.y(), rho0);
+  const Mat3 P_ff = Vec3(sigma_z * sigma_z, sigma_z * sigma_z, sigma_rho0 * sigma_rho0).asDiagonal();
+  state.addFeature(f, P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim()));
+}
+
+bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, const Vec3& abr, double sigma2,
+                           SlamFeature* f, Mat3* P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>* P_fx, MatX* H2,
+                           VecX* r2, const std::function<void(MatX*)>& constrain) {
+  if (track.observations.size() < 2) return false;
+  const int a = state.findClone(track.observations.back().clone_id);
+  if (a < 0) return false;
+  const CameraClone& anchor = state.clones[static_cast<std::size_t>(a)];
+  std::vector<const TrackObservation*> obs;
+  for (const TrackObservation& o : track.observations)
+    if (state.findClone(o.clone_id) >= 0) obs.push_back(&o);
+  const Eigen::Index m = 2 * static_cast<Eigen::Index>(obs.size());
+  if (m < 4) return false;
+  MatX H_x = MatX::Zero(m, state.dim());
+  MatX H_f(m, 3);
+  VecX r(m);
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const std::size_t c = static_cast<std::size_t>(state.findClone(obs[i]->clone_id));
+    Vec2 zh;
+    Mat26 Ha, Hc;
+    Mat23 Hf;
+    if (!projectAnchoredFeature(anchor, state.clones[c], abr, &zh, &Ha, &Hc, &Hf)) return false;
+    const Eigen::Index row = 2 * static_cast<Eigen::Index>(i);
+    H_x.block<2, 6>(row, state.cloneIndex(static_cast<std::size_t>(a))) += Ha;
+    H_x.block<2, 6>(row, state.cloneIndex(c)) += Hc;
+    H_f.block<2, 3>(row, 0) = Hf;
+    r.segment<2>(row) = obs[i]->z - zh;
+  }
+  if (constrain) constrain(&H_x);
+  const Eigen::HouseholderQR<MatX> qr(H_f);
+  const MatX QtH = qr.householderQ().adjoint() * H_x;
+  const VecX Qtr = qr.householderQ().adjoint() * r;
+  const Mat3 R1 = qr.matrixQR().topRows(3).triangularView<Eigen::Upper>();
+  const double d = std::abs(R1(0, 0) * R1(1, 1) * R1(2, 2));
+  if (!(d > 1e-12) || !std::isfinite(d)) return false;
+  const Mat3 R1inv = R1.inverse();
+  const MatX H1 = QtH.topRows(3);
+  const MatX H1P = H1 * state.P;
+  f->id = track.id;
+  f->anchor_clone_id = anchor.id;
+  f->abr = abr + R1inv * Qtr.head<3>();
+  f->gate_failures = 0;
+  Mat3 S1 = H1P * H1.transpose();
+  S1.diagonal().array() += sigma2;
+  *P_ff = R1inv * S1 * R1inv.transpose();
+  *P_ff = 0.5 * (*P_ff + P_ff->transpose()).eval();
+  *P_fx = -R1inv * H1P;
+  *H2 = QtH.bottomRows(m - 3);
+  *r2 = Qtr.tail(m - 3);
+  return f->abr.allFinite() && P_ff->allFinite();
+}
+
+double slamMahalanobis(const FilterState& state, const MatX& H, const VecX& r, double sigma2) {
+  return mahalanobisSquared(H, r, state.P, sigma2);
+}
+
+bool slamUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph) {
+  return ekfUpdate(state, H, r, sigma2, joseph);
+}
+
+bool reanchorSlamFeature(FilterState& state, std::size_t j, std::size_t to, const VecX* yaw_direction) {
+  SlamFeature& f = state.features[j];
+  const int from = state.findClone(f.anchor_clone_id);
+  if (from < 0) return false;
+  if (static_cast<std::size_t>(from) == to) return true;
+  Vec3 abr_new;
+  Mat36 J_from, J_to;
+  Mat3 J_f;
+  if (!reanchorFeature(state.clones[static_cast<std::size_t>(from)], state.clones[to], f.abr, &abr_new, &J_from,
+                       &J_to, &J_f))
+    return false;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim());
+  J.block<3, 6>(0, state.cloneIndex(static_cast<std::size_t>(from))) = J_from;
+  J.block<3, 6>(0, state.cloneIndex(to)) = J_to;
+  const int k = state.featureIndex(j);
+  J.block<3, 3>(0, k) = J_f;
+  if (yaw_direction != nullptr) {
+    // The anchored parameters have no component along n: keep J n = 0.
+    const VecX& n = *yaw_direction;
+    J -= (J * n) * (n.transpose() / n.squaredNorm());
+  }
+  // P' = T P Tᵀ: only the feature's rows and columns change.
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> C = J * state.P;  // new cross-covariance row block
+  const Mat3 P_ff = C * J.transpose();
+  state.P.middleRows(k, 3) = C;
+  state.P.middleCols(k, 3) = C.transpose();
+  state.P.block<3, 3>(k, k) = 0.5 * (P_ff + P_ff.transpose());
+  f.abr = abr_new;
+  f.anchor_clone_id = state.clones[to].id;
+  return true;
+}
+
+}  // namespace evio::estimator

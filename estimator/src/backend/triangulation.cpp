@@ -1,0 +1,87 @@
+#include "evio/estimator/backend/triangulation.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "evio/estimator/backend/visual_models.h"
+
+namespace evio::estimator {
+
+bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z, std::size_t anchor,
+                        const TriangulationOptions& options, TriangulationResult* result) {
+  const std::size_t n = clones.size();
+  if (n < 2 || z.size() != n || anchor >= n) return false;
+
+  // 1. Linear start.
+  Mat3 A = Mat3::Zero();
+  Vec3 rhs = Vec3::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 b = (clones[i].R_W_C() * Vec3(z[i].x(), z[i].y(), 1.0)).normalized();
+    const Mat3 M = Mat3::Identity() - b * b.transpose();
+    A += M;
+    rhs += M * clones[i].p_W_C;
+  }
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(A);
+  const Vec3 ev = eig.eigenvalues();
+  if (!(ev(0) > 1e-12 * ev(2))) return false;
+  const Vec3 p0 = A.ldlt().solve(rhs);
+  Vec3 abr;
+  if (!worldToAnchored(clones[anchor], p0, &abr)) return false;
+
+  // 2. Gauss–Newton in inverse depth.
+  Eigen::MatrixXd J(2 * n, 3);
+  Eigen::VectorXd r(2 * n);
+  auto evaluate = [&](const Vec3& x, bool jac) {
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec2 zi;
+      Mat23 Ji;
+      if (!projectAnchoredFeature(clones[anchor], clones[i], x, &zi, nullptr, nullptr, jac ? &Ji : nullptr))
+        return false;
+      r.segment<2>(2 * static_cast<Eigen::Index>(i)) = z[i] - zi;
+      if (jac) J.block<2, 3>(2 * static_cast<Eigen::Index>(i), 0) = Ji;
+    }
+    return true;
+  };
+  int it = 0;
+  for (; it < options.max_iterations; ++it) {
+    if (!evaluate(abr, true)) return false;
+    const Mat3 JtJ = J.transpose() * J;
+    const Vec3 step = JtJ.ldlt().solve(J.transpose() * r);
+    if (!step.allFinite()) return false;
+    abr += step;
+    if (step.norm() <= options.tolerance * abr.norm()) {
+      ++it;
+      break;
+    }
+  }
+  if (!evaluate(abr, false)) return false;
+  const double rho = abr.z();
+  if (!(rho > 0.0) || 1.0 / rho > options.max_depth_m) return false;
+  const Vec3 p_W = anchoredToWorld(clones[anchor], abr);
+  for (const CameraClone& c : clones) {
+    const double depth = (c.R_W_C().transpose() * (p_W - c.p_W_C)).z();
+    if (!(depth >= options.min_depth_m)) return false;
+  }
+  result->abr = abr;
+  result->p_W = p_W;
+  result->iterations = it;
+  result->rms_residual = std::sqrt(r.squaredNorm() / static_cast<double>(n));
+  if (options.max_rms_residual > 0.0 && result->rms_residual > options.max_rms_residual) return false;
+  return true;
+}
+
+double rotationCompensatedDisparity(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z) {
+  if (clones.size() < 2) return 0.0;
+  const Mat3 Rlt = clones.back().R_W_C().transpose();
+  double best = 0.0;
+  for (std::size_t i = 0; i + 1 < clones.size(); ++i) {
+    const Vec3 b = Rlt * clones[i].R_W_C() * Vec3(z[i].x(), z[i].y(), 1.0);
+    if (!(b.z() > 0.0)) return 1e9;  // rotated behind: certainly a large disparity
+    best = std::max(best, (b.head<2>() / b.z() - z.back()).norm());
+  }
+  return best;
+}
+
+}  // namespace evio::estimator

@@ -1,0 +1,114 @@
+// Seeded Monte Carlo tests of the whole backend on noisy ground-truth tracks
+// (ctest label `slow`): NEES consistency on six_dof, and non-divergence on
+// rotation_only and hover. Seeds 1..50, fixed.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "backend_scenarios.h"
+#include "evio/estimator/backend/chi_squared.h"
+
+namespace evio::estimator {
+namespace {
+
+constexpr int kSeeds = 50;
+constexpr double kDuration_s = 30.0;
+
+struct Summary {
+  int runs = 0, not_ok = 0, not_pd = 0;
+  std::vector<std::vector<double>> nees;  // [run][update]
+  double worst_ratio = 0.0;               // max |e_i| / 3σ_i over runs
+  double outside_3sigma = 0.0;            // fraction of (estimate, component) beyond 3σ
+  std::int64_t msckf = 0, slam_prior = 0, slam_tri = 0;
+};
+
+Summary runSeeds(const ContinuousTrajectory& traj, const test::BackendScenario& sc) {
+  Summary s;
+  std::int64_t beyond = 0, total = 0;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    const test::ScenarioResult r = test::runBackendScenario(traj, sc, static_cast<std::uint64_t>(seed));
+    ++s.runs;
+    if (!r.status.ok()) {
+      ++s.not_ok;
+      std::printf("seed %d: %s at %.3f s: %s\n", seed, statusName(r.status.code), nsToSeconds(r.status.t_ns),
+                  r.status.cause.c_str());
+    }
+    if (!r.always_pd) ++s.not_pd;
+    s.nees.push_back(r.nees);
+    s.worst_ratio = std::max(s.worst_ratio, r.max_error_over_3sigma);
+    for (std::size_t k = 0; k < r.error.size(); ++k)
+      for (int i = 0; i < 6; ++i, ++total) beyond += std::abs(r.error[k](i)) > 3.0 * r.sigma[k](i) ? 1 : 0;
+    s.msckf += r.stats.msckf_features_used;
+    s.slam_prior += r.stats.slam_initialized_prior;
+    s.slam_tri += r.stats.slam_initialized_triangulated;
+  }
+  s.outside_3sigma = total > 0 ? static_cast<double>(beyond) / static_cast<double>(total) : 0.0;
+  return s;
+}
+
+void report(const char* name, const Summary& s) {
+  std::printf("%s: %d runs, %d not ok, %d non-PD, worst |e|/3σ %.2f, beyond 3σ %.3f %%, "
+              "MSCKF features %lld, SLAM init prior %lld / triangulated %lld\n",
+              name, s.runs, s.not_ok, s.not_pd, s.worst_ratio, 100.0 * s.outside_3sigma,
+              static_cast<long long>(s.msckf), static_cast<long long>(s.slam_prior),
+              static_cast<long long>(s.slam_tri));
+}
+
+TEST(BackendConsistency, SixDofPoseNeesInsideTheTwoSided95PercentBounds) {
+  const auto traj = test::scenarioTrajectory("six_dof");
+  test::BackendScenario sc = test::sixDofScenario(*traj);
+  sc.max_duration_s = kDuration_s;
+  const Summary s = runSeeds(*traj, sc);
+  report("six_dof", s);
+  ASSERT_EQ(s.not_ok, 0);
+  // ANEES per update over the runs, then its mean over the updates.
+  std::size_t K = s.nees.front().size();
+  for (const auto& n : s.nees) K = std::min(K, n.size());
+  ASSERT_GT(K, 100u);
+  const double R = kSeeds;
+  const double lo = chi2Quantile(0.025, 6 * R) / R, hi = chi2Quantile(0.975, 6 * R) / R;
+  double mean = 0.0;
+  int inside = 0;
+  for (std::size_t k = 0; k < K; ++k) {
+    double a = 0.0;
+    for (const auto& n : s.nees) a += n[k];
+    a /= R;
+    mean += a / static_cast<double>(K);
+    inside += (a >= lo && a <= hi) ? 1 : 0;
+  }
+  std::printf("six_dof: average pose NEES %.3f (6 dof), two-sided 95%% bounds [%.3f, %.3f], "
+              "%.1f %% of %zu updates inside\n",
+              mean, lo, hi, 100.0 * inside / static_cast<double>(K), K);
+  RecordProperty("average_pose_nees", std::to_string(mean));
+  EXPECT_GE(mean, lo);
+  EXPECT_LE(mean, hi);
+}
+
+// Non-divergence: every run stays ok (finite, PD covariance, bounded
+// velocity), every pose covariance is PD, and the pose error stays bounded by
+// its 3σ: at most 2 % of (estimate, component) pairs beyond 3σ (a consistent
+// filter has 0.27 %) and none beyond twice that (6σ).
+void expectNoDivergence(const char* name, const Summary& s) {
+  report(name, s);
+  EXPECT_EQ(s.not_ok, 0) << name;
+  EXPECT_EQ(s.not_pd, 0) << name;
+  EXPECT_LT(s.outside_3sigma, 0.02) << name;
+  EXPECT_LT(s.worst_ratio, 2.0) << name;
+}
+
+TEST(BackendConsistency, RotationOnlyNeverDiverges) {
+  const auto traj = test::scenarioTrajectory("rotation_only");
+  test::BackendScenario sc = test::rotationOnlyScenario(*traj);
+  sc.max_duration_s = kDuration_s;
+  expectNoDivergence("rotation_only", runSeeds(*traj, sc));
+}
+
+TEST(BackendConsistency, HoverNeverDiverges) {
+  const auto traj = test::scenarioTrajectory("hover");
+  test::BackendScenario sc = test::hoverScenario(*traj);
+  sc.max_duration_s = kDuration_s;
+  expectNoDivergence("hover", runSeeds(*traj, sc));
+}
+
+}  // namespace
+}  // namespace evio::estimator

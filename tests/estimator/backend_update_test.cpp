@@ -1,0 +1,265 @@
+// Triangulation, null-space projection, re-anchoring, QR compression and the
+// EKF update of the backend against exact ground truth.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "evio/core/random_stream.h"
+#include "evio/core/so3.h"
+#include "evio/estimator/backend/chi_squared.h"
+#include "evio/estimator/backend/ekf_update.h"
+#include "evio/estimator/backend/msckf_update.h"
+#include "evio/estimator/backend/slam_features.h"
+#include "evio/estimator/backend/triangulation.h"
+#include "evio/estimator/backend/visual_models.h"
+
+namespace evio::estimator {
+namespace {
+
+Vec3 randVec(RandomStream& rng, double s) { return Vec3(rng.normal(), rng.normal(), rng.normal()) * s; }
+
+// n clones along a short arc, looking along +x of W.
+std::vector<CameraClone> arcOfClones(int n, std::uint64_t seed, double baseline_m = 0.3) {
+  RandomStream rng(seed, "clones");
+  Mat3 R_look;
+  R_look.col(0) = Vec3(0, -1, 0);
+  R_look.col(1) = Vec3(0, 0, -1);
+  R_look.col(2) = Vec3(1, 0, 0);
+  std::vector<CameraClone> out;
+  for (int i = 0; i < n; ++i) {
+    CameraClone c;
+    c.id = i;
+    c.p_W_C = Vec3(0.0, baseline_m * i / std::max(1, n - 1), 0.05 * std::sin(i)) + randVec(rng, 0.01);
+    c.q_W_C = Quat(R_look * so3::exp(randVec(rng, 0.05)));
+    out.push_back(c);
+  }
+  return out;
+}
+
+FilterState stateWith(const std::vector<CameraClone>& clones, std::uint64_t seed) {
+  RandomStream rng(seed, "cov");
+  FilterState s;
+  s.clones = clones;
+  const int n = s.dim();
+  MatX A(n, n);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) A(r, c) = rng.normal();
+  s.P = 1e-4 * (A * A.transpose() / n + MatX::Identity(n, n));
+  return s;
+}
+
+TEST(BackendTriangulation, ExactObservationsGiveTheExactPoint) {
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    RandomStream rng(seed, "point");
+    const auto clones = arcOfClones(2 + static_cast<int>(seed % 9), seed);
+    const Vec3 p_true = Vec3(rng.uniform(1.0, 20.0), rng.uniform(-2, 2), rng.uniform(-2, 2));
+    std::vector<Vec2> z;
+    for (const CameraClone& c : clones) {
+      Vec2 zi;
+      ASSERT_TRUE(projectWorldPoint(c, p_true, &zi));
+      z.push_back(zi);
+    }
+    TriangulationResult res;
+    ASSERT_TRUE(triangulateFeature(clones, z, clones.size() - 1, TriangulationOptions{}, &res)) << seed;
+    EXPECT_LT((res.p_W - p_true).norm(), 1e-9 * p_true.norm()) << "seed " << seed;
+    EXPECT_LT(res.rms_residual, 1e-12);
+  }
+}
+
+TEST(BackendTriangulation, RejectsDegenerateAndBehindPoints) {
+  auto clones = arcOfClones(3, 5);
+  for (auto& c : clones) c.p_W_C = clones[0].p_W_C;  // no baseline at all
+  std::vector<Vec2> z(3, Vec2(0.01, 0.02));
+  TriangulationResult res;
+  EXPECT_FALSE(triangulateFeature(clones, z, 2, TriangulationOptions{}, &res));
+  EXPECT_FALSE(triangulateFeature({clones[0]}, {z[0]}, 0, TriangulationOptions{}, &res));
+  // Rays that meet behind the cameras.
+  auto arc = arcOfClones(3, 6);
+  std::vector<Vec2> zb;
+  for (const auto& c : arc) {
+    const Vec3 h = c.R_W_C().transpose() * (Vec3(-5.0, 0.1, 0.0) - c.p_W_C);
+    zb.push_back(h.head<2>() / h.z());
+  }
+  EXPECT_FALSE(triangulateFeature(arc, zb, 2, TriangulationOptions{}, &res));
+}
+
+TEST(BackendTriangulation, RotationCompensatedDisparity) {
+  auto clones = arcOfClones(3, 7);
+  for (auto& c : clones) c.p_W_C.setZero();  // pure rotation: no parallax
+  const Vec3 p(6.0, 0.5, -0.3);
+  std::vector<Vec2> z;
+  for (const auto& c : clones) {
+    Vec2 zi;
+    ASSERT_TRUE(projectWorldPoint(c, p, &zi));
+    z.push_back(zi);
+  }
+  EXPECT_LT(rotationCompensatedDisparity(clones, z), 1e-12);
+  clones[0].p_W_C = Vec3(0.0, 0.6, 0.0);  // 0.6 m sideways at 6 m: about 0.1 rad
+  ASSERT_TRUE(projectWorldPoint(clones[0], p, &z[0]));
+  EXPECT_NEAR(rotationCompensatedDisparity(clones, z), 0.1, 0.02);
+}
+
+TEST(BackendNullSpace, ProjectionRemovesTheFeature) {
+  const auto clones = arcOfClones(6, 8);
+  FilterState s = stateWith(clones, 8);
+  const Vec3 p_true(5.0, 0.4, -0.2);
+  FeatureTrack track;
+  track.id = 1;
+  RandomStream rng(8, "noise");
+  for (const auto& c : clones) {
+    Vec2 zi;
+    ASSERT_TRUE(projectWorldPoint(c, p_true, &zi));
+    track.observations.push_back({c.id, zi + Vec2(rng.normal(), rng.normal()) * 1e-3});
+  }
+  MsckfResidual res;
+  ASSERT_EQ(msckfResidual(s, track, 0.0, TriangulationOptions{}, &res), MsckfOutcome::kOk);
+  EXPECT_EQ(res.r.size(), 2 * 6 - 3);
+  EXPECT_EQ(res.H.cols(), s.dim());
+
+  // H_fᵀ N = 0 for the null space N the projection used.
+  MatX H_f(12, 3), H_x = MatX::Zero(12, s.dim());
+  VecX r(12);
+  for (std::size_t i = 0; i < clones.size(); ++i) {
+    Vec2 zh;
+    Mat26 Hc;
+    Mat23 Hp;
+    ASSERT_TRUE(projectWorldPoint(clones[i], res.p_W, &zh, &Hc, &Hp));
+    H_f.block<2, 3>(2 * static_cast<Eigen::Index>(i), 0) = Hp;
+    H_x.block<2, 6>(2 * static_cast<Eigen::Index>(i), s.cloneIndex(i)) = Hc;
+    r.segment<2>(2 * static_cast<Eigen::Index>(i)) = track.observations[i].z - zh;
+  }
+  MatX N;
+  MatX Hx2 = H_x;
+  VecX r2 = r;
+  projectOnLeftNullSpace(H_f, &Hx2, &r2, &N);
+  EXPECT_LT((H_f.transpose() * N).norm(), 1e-12 * H_f.norm());
+  EXPECT_LT((N.transpose() * N - MatX::Identity(9, 9)).norm(), 1e-12);
+  EXPECT_LT((r2 - res.r).norm(), 1e-12);
+
+  // The projected residual does not depend on the feature's error (to first
+  // order): moving the point by 1 mm changes r by ~1e-4, N^T r by O(1e-8).
+  for (const Vec3& d : {Vec3(1e-3, 0, 0), Vec3(0, 1e-3, 0), Vec3(0, 0, 1e-3)}) {
+    VecX rd(12);
+    for (std::size_t i = 0; i < clones.size(); ++i) {
+      Vec2 zh;
+      ASSERT_TRUE(projectWorldPoint(clones[i], res.p_W + d, &zh));
+      rd.segment<2>(2 * static_cast<Eigen::Index>(i)) = track.observations[i].z - zh;
+    }
+    EXPECT_GT((rd - r).norm(), 1e-5);
+    EXPECT_LT((N.transpose() * (rd - r)).norm(), 1e-7);
+  }
+}
+
+// World point of feature j and its covariance, J P Jᵀ with J = ∂p_W/∂δx.
+std::pair<Vec3, Mat3> worldPointAndCovariance(const FilterState& s, std::size_t j) {
+  const SlamFeature& f = s.features[j];
+  const auto a = static_cast<std::size_t>(s.findClone(f.anchor_clone_id));
+  Mat36 J_a;
+  Mat3 J_f;
+  const Vec3 p = anchoredToWorld(s.clones[a], f.abr, &J_a, &J_f);
+  MatX J = MatX::Zero(3, s.dim());
+  J.block<3, 6>(0, s.cloneIndex(a)) = J_a;
+  J.block<3, 3>(0, s.featureIndex(j)) = J_f;
+  return {p, J * s.P * J.transpose()};
+}
+
+TEST(BackendReanchoring, PreservesWorldPointAndItsCovariance) {
+  const auto clones = arcOfClones(5, 9);
+  FilterState s = stateWith(clones, 9);
+  RandomStream rng(9, "features");
+  for (int j = 0; j < 3; ++j) {
+    SlamFeature f;
+    f.id = j;
+    f.anchor_clone_id = 0;
+    ASSERT_TRUE(worldToAnchored(clones[0], Vec3(4.0 + j, 0.3 * j, -0.2), &f.abr));
+    MatX C(3, s.dim());
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < s.dim(); ++c) C(r, c) = 1e-6 * rng.normal();
+    s.addFeature(f, Vec3(1e-4, 1e-4, 4e-3).asDiagonal(), C);
+  }
+  ASSERT_GT(Eigen::SelfAdjointEigenSolver<MatX>(s.P).eigenvalues().minCoeff(), 0.0);
+  for (std::size_t j = 0; j < 3; ++j) {
+    const auto [p0, C0] = worldPointAndCovariance(s, j);
+    const MatX P_before = s.P;
+    ASSERT_TRUE(reanchorSlamFeature(s, j, 4));
+    EXPECT_EQ(s.features[j].anchor_clone_id, 4);
+    const auto [p1, C1] = worldPointAndCovariance(s, j);
+    EXPECT_LT((p1 - p0).norm(), 1e-12 * p0.norm());
+    EXPECT_LT((C1 - C0).norm(), 1e-9 * C0.norm()) << "feature " << j;
+    // Everything but the feature's rows and columns is untouched.
+    const int k = s.featureIndex(j);
+    EXPECT_TRUE(s.P.topLeftCorner(k, k) == P_before.topLeftCorner(k, k));
+    EXPECT_LT((s.P - s.P.transpose()).norm(), 1e-18);
+  }
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(s.P).eigenvalues().minCoeff(), 0.0);
+}
+
+TEST(BackendEkfUpdate, QrCompressionAndJosephFormGiveTheSameUpdate) {
+  const auto clones = arcOfClones(4, 10);
+  const FilterState s0 = stateWith(clones, 10);
+  RandomStream rng(10, "H");
+  const int m = 60, n = s0.dim();
+  MatX H(m, n);
+  VecX r(m);
+  for (int i = 0; i < m; ++i) {
+    r(i) = 1e-3 * rng.normal();
+    for (int k = 0; k < n; ++k) H(i, k) = rng.normal();
+  }
+  const double sigma2 = 1e-4;
+  FilterState a = s0, b = s0, c = s0;
+  ASSERT_TRUE(ekfUpdate(a, H, r, sigma2, true));
+  MatX Hc = H;
+  VecX rc = r;
+  compressMeasurement(&Hc, &rc);
+  EXPECT_EQ(Hc.rows(), n);
+  ASSERT_TRUE(ekfUpdate(b, Hc, rc, sigma2, true));
+  ASSERT_TRUE(ekfUpdate(c, H, r, sigma2, false));
+  EXPECT_LT((a.P - b.P).norm(), 1e-10 * a.P.norm());
+  EXPECT_LT((a.P - c.P).norm(), 1e-10 * a.P.norm());
+  for (std::size_t i = 0; i < clones.size(); ++i) {
+    EXPECT_LT((a.clones[i].p_W_C - b.clones[i].p_W_C).norm(), 1e-12);
+    EXPECT_LT(angleBetween(a.clones[i].q_W_C, b.clones[i].q_W_C), 1e-12);
+  }
+  EXPECT_LT((a.P - a.P.transpose()).norm(), 1e-18);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(a.P).eigenvalues().minCoeff(), 0.0);
+  EXPECT_DOUBLE_EQ(mahalanobisSquared(MatX::Identity(1, n), VecX::Zero(1), s0.P, 1.0), 0.0);
+}
+
+TEST(BackendSlamInit, DepthPriorAndTriangulatedInitialisation) {
+  const auto clones = arcOfClones(8, 11, 1.0);
+  FilterState s = stateWith(clones, 11);
+  const Vec3 p_true(4.0, 0.5, 0.3);
+  FeatureTrack track;
+  track.id = 7;
+  for (const auto& c : clones) {
+    Vec2 zi;
+    ASSERT_TRUE(projectWorldPoint(c, p_true, &zi));
+    track.observations.push_back({c.id, zi});
+  }
+  // Depth prior on the newest clone: ρ0 = 1/(2 d_min), σ = 1/(4 d_min), no cross terms.
+  FilterState prior = s;
+  addSlamFeatureWithPrior(prior, 7, 7, track.observations.back().z, 1.3, 0.65, 0.01);
+  ASSERT_EQ(prior.features.size(), 1u);
+  EXPECT_EQ(prior.features[0].anchor_clone_id, 7);
+  EXPECT_DOUBLE_EQ(prior.features[0].abr.z(), 1.3);
+  EXPECT_DOUBLE_EQ(prior.P(prior.featureIndex(0) + 2, prior.featureIndex(0) + 2), 0.65 * 0.65);
+  EXPECT_EQ(prior.P.block(prior.featureIndex(0), 0, 3, prior.featureIndex(0)).norm(), 0.0);
+
+  // Triangulated (Li & Mourikis): exact observations give the exact point.
+  std::vector<CameraClone> cl;
+  std::vector<std::size_t> pos;
+  std::vector<Vec2> z;
+  gatherTrack(s, track, &cl, &pos, &z);
+  TriangulationResult tri;
+  ASSERT_TRUE(triangulateFeature(cl, z, cl.size() - 1, TriangulationOptions{}, &tri));
+  const Chi2Table chi2(0.95);
+  ASSERT_EQ(addSlamFeatureTriangulated(s, track, tri.abr, 1e-6, true, chi2, [](MatX*) {}), SlamInitOutcome::kOk);
+  ASSERT_EQ(s.features.size(), 1u);
+  const Vec3 p_est = anchoredToWorld(s.clones.back(), s.features[0].abr);
+  EXPECT_LT((p_est - p_true).norm(), 1e-8);
+  EXPECT_LT((s.P - s.P.transpose()).norm(), 1e-18);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(s.P).eigenvalues().minCoeff(), 0.0);
+}
+
+}  // namespace
+}  // namespace evio::estimator

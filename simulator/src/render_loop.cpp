@@ -245,7 +245,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
     if (!separate && frame && t == t_frame) addSample(last.radiance);
     if (frame && t == t_depth) {
       const auto t0 = Clock::now();
-      writer.appendDepth(frame->index, t, last.depth);
+      writer.appendDepth(frame->index, t, last.depth, o.output.flow_at_frames ? last.flow : cv::Mat());
       stats->write_s += secondsSince(t0);
       frame->depth_done = true;
     }

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/core.hpp>
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
@@ -45,10 +46,17 @@ std::size_t SequenceWriter::appendFrame(TimeNs t_ns, const cv::Mat& image) {
   return static_cast<std::size_t>(frames_++);
 }
 
-void SequenceWriter::appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth) {
+void SequenceWriter::appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth, const cv::Mat& flow) {
   char name[40];
   std::snprintf(name, sizeof(name), "depth/depth_%08zu.exr", index);
-  io::writeExr((fs::path(folder_) / "truth" / name).string(), {{"Z", depth}});
+  std::vector<io::ExrChannel> channels = {{"Z", depth}};
+  if (!flow.empty()) {
+    cv::Mat uv[2];
+    cv::split(flow, uv);
+    channels.emplace_back("U", uv[0]);
+    channels.emplace_back("V", uv[1]);
+  }
+  io::writeExr((fs::path(folder_) / "truth" / name).string(), channels);
   io::appendSeconds(depth_list_, t_ns);
   depth_list_ += ' ';
   depth_list_ += name;
@@ -71,7 +79,8 @@ std::vector<std::string> SequenceWriter::close() {
   }
   if (options_.depth) {
     const std::string list = (fs::path(folder_) / "truth" / "depth.txt").string();
-    io::writeFileAtomic(list, "# t depth/depth_XXXXXXXX.exr: event-camera depth (channel Z, m) at frame stamps\n" +
+    io::writeFileAtomic(list, "# t depth/depth_XXXXXXXX.exr: event-camera depth (channel Z, m; U, V: motion field, px/s, when written) "
+                                  "at frame stamps\n" +
                                   depth_list_);
     files_.push_back(list);
   }

@@ -19,6 +19,8 @@
 #include "evio/core/io/range_txt.h"
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/io/tum.h"
+#include "evio/core/so3.h"
+#include "evio/simulator/motion_field.h"
 #include "evio/simulator/sequence_simulator.h"
 #include "temp_dir.h"
 
@@ -169,6 +171,39 @@ TEST(SequenceSimulator, ResolvedScenarioReproducesTheFolder) {
     if (f == "simulation_stats.yaml") continue;
     EXPECT_EQ(io::readFile(tmp.file("a/" + f)), io::readFile(tmp.file("b/" + f))) << f;
   }
+}
+
+TEST(SequenceSimulator, FlowAtFramesIsTheMotionFieldOfTheTrueVelocity) {
+  test::TempDir tmp;
+  const Scenario s = loadTestScenario({"output.flow_at_frames=true", "output.write_events_txt=false"});
+  simulateSequence(s, tmp.file("s"));
+  const auto stamps = io::readImageList(tmp.file("s"));
+  ASSERT_GE(stamps.size(), 3u);
+  const auto channels = io::readExr(tmp.file("s/truth/depth/depth_00000002.exr"));
+  ASSERT_EQ(channels.size(), 3u);  // U, V, Z (sorted by name)
+  EXPECT_EQ(channels[0].first, "U");
+  EXPECT_EQ(channels[1].first, "V");
+  EXPECT_EQ(channels[2].first, "Z");
+  // The velocity of E at the frame stamp by central differences of its pose
+  // (h = 10 µs), and the motion field of the stored depth (motion_field.h).
+  const auto T_W_E = [&](TimeNs t) { return s.trajectory->evaluate(t).T_W_B * s.T_B_E(); };
+  const TimeNs t = stamps[2].t_ns, h = 10'000;
+  const Pose a = T_W_E(t - h), b = T_W_E(t + h), c = T_W_E(t);
+  CameraVelocity v;
+  v.v_C = c.rotation().transpose() * (b.translation() - a.translation()) / (2e-9 * h);
+  v.omega_C = so3::log(Mat3(a.rotation().transpose() * b.rotation())) / (2e-9 * h);
+  const cv::Mat expected = motionFieldFromDepth(s.eventCamera(), channels[2].second, v);
+  double worst = 0.0, mean_speed = 0.0;
+  for (int y = 0; y < 48; ++y)
+    for (int x_px = 0; x_px < 64; ++x_px) {
+      const cv::Vec2f e = expected.at<cv::Vec2f>(y, x_px);
+      const Vec2 got(channels[0].second.at<float>(y, x_px), channels[1].second.at<float>(y, x_px));
+      worst = std::max(worst, (got - Vec2(e[0], e[1])).norm() / (1.0 + Vec2(e[0], e[1]).norm()));
+      mean_speed += Vec2(e[0], e[1]).norm() / (64.0 * 48.0);
+    }
+  EXPECT_LT(worst, 1e-3);         // relative: float images, O(h²) differences
+  EXPECT_GT(mean_speed, 30.0);    // 1.4 m/s at 1 m with f = 45 px: about 64 px/s
+  EXPECT_LT(mean_speed, 120.0);
 }
 
 TEST(SequenceSimulator, SeparateFrameCameraHasItsOwnResolution) {

@@ -178,6 +178,7 @@ struct SequenceOutputOptions {
   int events_h5_compression = 0;      ///< gzip level of events.h5 (0: none, fastest)
   double groundtruth_rate_hz = 200.0; ///< groundtruth.txt and truth/tracks.txt rate, Hz
   bool depth_at_frames = true;        ///< truth/depth/*.exr: event-camera depth at each frame stamp
+  bool flow_at_frames = false;        ///< add the motion field (channels U, V, px/s) to those files (3× the size)
   int truth_tracks = 100;             ///< ground-truth feature tracks (points visible at the start)
   double truth_track_border_px = 8.0; ///< track points are picked this far inside the image, px
 
@@ -187,6 +188,7 @@ struct SequenceOutputOptions {
     v("events_h5_compression", events_h5_compression, "gzip level of events.h5, 0 = none");
     v("groundtruth_rate_hz", groundtruth_rate_hz, "groundtruth.txt and truth/tracks.txt rate, Hz");
     v("depth_at_frames", depth_at_frames, "event-camera depth EXR at frame stamps");
+    v("flow_at_frames", flow_at_frames, "add the motion field (U, V, px/s) to the depth EXR files");
     v("truth_tracks", truth_tracks, "number of ground-truth feature tracks");
     v("truth_track_border_px", truth_track_border_px, "margin of the track start points, px");
   }

@@ -12,7 +12,8 @@
 ///   events.h5, events.txt, images.txt, images/    (sequence_writer.h)
 ///   range.txt             when the rig has a range finder
 ///   truth/imu_state.txt   true IMU state and biases at every IMU sample
-///   truth/event_labels.bin, truth/depth.txt, truth/depth/   (sequence_writer.h)
+///   truth/event_labels.bin, truth/depth.txt, truth/depth/   (sequence_writer.h; depth,
+///                         and the motion field with output.flow_at_frames)
 ///   truth/track_points.txt, truth/tracks.txt, truth/tracks_occluded.txt
 ///                         ground-truth feature tracks (truth_tracks.h) at the
 ///                         groundtruth.txt stamps: tracks.txt the visible samples,

@@ -8,7 +8,8 @@
 ///   images.txt, images/       8-bit frames
 ///   truth/depth.txt, truth/depth/depth_XXXXXXXX.exr
 ///                             event-camera depth (channel Z, m along the optical
-///                             axis, +inf: no surface) at frame stamps; index XXXXXXXX
+///                             axis, +inf: no surface) at frame stamps, optionally with
+///                             the motion field (channels U, V, px/s); index XXXXXXXX
 ///                             = the frame's index in images/; depth.txt lists
 ///                             `t depth/depth_XXXXXXXX.exr` like images.txt
 /// Each file appears under its name only when complete (close()).
@@ -48,8 +49,9 @@ class SequenceWriter {
   void appendEvents(const EventArray& events, const std::vector<EventLabel>& labels);
   /// A frame stamped t_ns (CV_8UC1); returns its index.
   std::size_t appendFrame(TimeNs t_ns, const cv::Mat& image);
-  /// Depth (CV_32FC1) at t_ns, named after frame `index`.
-  void appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth);
+  /// Depth (CV_32FC1) at t_ns, named after frame `index`; with a non-empty
+  /// `flow` (CV_32FC2, px/s) also its channels U and V.
+  void appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth, const cv::Mat& flow = cv::Mat());
   /// Closes every file; returns the paths written.
   std::vector<std::string> close();
 

@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 seconds=${1:-180}
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is required (apt-get install clang)"; exit 1; }
 cmake --preset fuzz >/dev/null
-names=(events_txt imu_txt tum images_txt config_yaml calib_txt sensors_yaml tracks_txt range_txt imu_state_txt)
+names=(events_txt imu_txt tum images_txt config_yaml calib_txt sensors_yaml tracks_txt range_txt imu_state_txt
+       track_points_txt event_labels_bin)
 targets=("${names[@]/#/fuzz_}")
 cmake --build --preset fuzz -j "$(nproc)" --target "${targets[@]}"
 corpus=build/fuzz/corpus
@@ -20,6 +21,8 @@ printf 'exposure_s: 0.02\ninner:\n  count: 5\noffset_m: [1, 2, 3]\nweights: [1, 
 printf '200.0 200.0 120.0 90.0 -0.37 0.16 0.0 0.0 0.0\n' > "$corpus/calib_txt/seed"
 printf '0 0.000 10.5 20.25\n0 0.005 10.6 20.3\n1 0.005 50 60\n' > "$corpus/tracks_txt/seed"
 printf '0.0 1.5 1\n0.1 0 0\n' > "$corpus/range_txt/seed"
+printf '# id px py pz\n0 1.5 -2 0.25\n3 -8.45 0.1 1e-3\n' > "$corpus/track_points_txt/seed"
+printf 'EVIOLBL1\003\000\000\000\000\000\000\000\000\001\003' > "$corpus/event_labels_bin/seed"
 cp tests/fuzz/seeds/sensors.yaml "$corpus/sensors_yaml/seed" 2>/dev/null || true
 for name in "${names[@]}"; do
   echo "== fuzz_$name for ${seconds}s"

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ struct BackendScenario {
   double update_rate_hz = 20.0;
   double skip_s = 0.0;  ///< estimates before start + skip_s are not scored
   double max_duration_s = 1e9;  ///< the run stops this long after the start
+  /// A laser range finder measuring to the plane z = 0 of W at every update
+  /// (noise σ 0.02 m, RandomStream(seed, "range")), when set.
+  std::optional<Pose> T_B_L;
 };
 
 struct ScenarioResult {
@@ -48,6 +52,12 @@ struct ScenarioResult {
   std::vector<double> nees;       ///< pose NEES (6 dof) per scored estimate
   std::vector<Vec6> error;        ///< [δp; δθ]
   std::vector<Vec6> sigma;        ///< sqrt of the diagonal of cov_pose_B
+  std::vector<double> yaw_sigma;  ///< σ of the world-frame yaw e_zᵀ R_W_B δθ, rad
+  std::vector<Vec3> velocity_error;  ///< v − v̂, m/s
+  std::vector<Vec3> velocity_sigma;  ///< m/s
+  /// Per measurement set: mean over the SLAM features of |d̂ − d|/d, d the depth
+  /// of the true landmark in the feature's (estimated) anchor camera.
+  std::vector<double> slam_depth_rel_error;
   bool always_pd = true;          ///< every scored pose covariance positive definite
   double max_error_over_3sigma = 0.0;  ///< max over estimates and components of |e_i| / (3 σ_i)
   int slam_features_max = 0;
@@ -67,6 +77,9 @@ inline ScenarioResult runBackendScenario(const ContinuousTrajectory& traj, const
   ImuSimulator sim(traj, imu, seed);
 
   BackendSensors sensors{sc.camera, sc.T_B_C, imu.gravity_mps2, ImuSensor{}, std::nullopt, 0};
+  constexpr double kRangeSigma = 0.02;
+  if (sc.T_B_L) sensors.range_finder = RangeFinderSensor{*sc.T_B_L, 0.1, 100.0, kRangeSigma};
+  RandomStream range_rng(seed, "range");
   sensors.imu.accelerometer_noise_density = imu.accelerometer_noise_density;
   sensors.imu.accelerometer_random_walk = imu.accelerometer_random_walk;
   sensors.imu.gyroscope_noise_density = imu.gyroscope_noise_density;
@@ -105,6 +118,10 @@ inline ScenarioResult runBackendScenario(const ContinuousTrajectory& traj, const
     out.nees.push_back(err.dot(llt.solve(err)));
     out.error.push_back(err);
     out.sigma.push_back(sig);
+    out.velocity_error.push_back(truth.v_W - e.imu.v_W);
+    out.velocity_sigma.push_back(e.cov_imu.diagonal().segment<3>(3).cwiseSqrt());
+    const Vec3 u = e.T_W_B.rotation().transpose() * Vec3::UnitZ();  // δψ = e_zᵀ R δθ = uᵀ δθ
+    out.yaw_sigma.push_back(std::sqrt(u.dot(e.cov_pose_B.bottomRightCorner<3, 3>() * u)));
     out.max_error_over_3sigma =
         std::max(out.max_error_over_3sigma, (err.cwiseAbs().array() / (3.0 * sig.array())).maxCoeff());
   };
@@ -114,7 +131,27 @@ inline ScenarioResult runBackendScenario(const ContinuousTrajectory& traj, const
   while (sim.next(m) && m.sample.t_ns <= stop_ns) {
     backend.addImu(m.sample);
     while (next_update <= m.sample.t_ns && next_update <= traj.endTime()) {
-      backend.addMeasurementSet(tracks.measure(next_update, traj.evaluate(next_update).T_W_B));
+      const Pose T_W_B = traj.evaluate(next_update).T_W_B;
+      backend.addMeasurementSet(tracks.measure(next_update, T_W_B));
+      const FilterState& st = backend.state();
+      double sum = 0.0;
+      int count = 0;
+      for (const SlamFeature& f : st.features) {
+        const Vec3* landmark = tracks.landmarkOf(f.id);
+        const int a = st.findClone(f.anchor_clone_id);
+        if (landmark == nullptr || a < 0 || !(f.abr.z() > 0.0)) continue;
+        const CameraClone& anchor = st.clones[static_cast<std::size_t>(a)];
+        const double depth = (anchor.R_W_C().transpose() * (*landmark - anchor.p_W_C)).z();
+        sum += std::abs(1.0 / f.abr.z() - depth) / depth;
+        ++count;
+      }
+      if (count > 0) out.slam_depth_rel_error.push_back(sum / count);
+      if (sc.T_B_L) {
+        const Pose T_W_L = T_W_B * *sc.T_B_L;
+        const Vec3 d = T_W_L.rotation().col(2);
+        const double range = -T_W_L.translation().z() / d.z();  // to the plane z = 0
+        backend.addRange(next_update, range + range_rng.normal() * kRangeSigma);
+      }
       next_update += period;
     }
     for (const BackendEstimate& e : backend.takeEstimates()) score(e);

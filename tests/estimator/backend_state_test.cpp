@@ -161,6 +161,26 @@ TEST(BackendStateJacobians, ImuTransitionIsTheJacobianOfTheIntegrator) {
   EXPECT_LT((Phi - test::numericJacobian<15, 15>(f, Vec15::Zero())).norm(), 1e-7);
 }
 
+TEST(BackendStateJacobians, CameraPoseOfTheImuState) {
+  RandomStream rng(5, "camera");
+  ImuState x;
+  x.p_W_B = randVec(rng, 1.0);
+  x.q_W_B = so3::expQuat(randVec(rng, 1.0));
+  const Pose T_B_C(so3::expQuat(Vec3(1.2, -0.3, 0.4)), Vec3(0.05, -0.02, 0.1));
+  Eigen::Matrix<double, 6, 15> J;
+  const Pose T_W_C = cameraPose(x, T_B_C, &J);
+  EXPECT_LT((T_W_C.matrix() - (x.T_W_B() * T_B_C).matrix()).norm(), 1e-15);
+  using Vec15 = Eigen::Matrix<double, 15, 1>;
+  const auto f = [&](const Vec15& d) {
+    const Pose T = cameraPose(boxPlus(x, d), T_B_C);
+    Vec6 e;
+    e.head<3>() = T.translation() - T_W_C.translation();
+    e.tail<3>() = so3::log(Quat(T_W_C.quaternion().conjugate() * T.quaternion()));
+    return e;
+  };
+  EXPECT_LT((J - test::numericJacobian<6, 15>(f, Vec15::Zero())).norm(), 1e-8);
+}
+
 TEST(BackendStateJacobians, DiscreteNoiseIsSymmetricPositiveDefinite) {
   ImuNoiseDensities n{0.004316, 0.0004316, 0.0002, 0.00002};
   const Mat15 Q = discreteImuNoise(so3::exp(Vec3(0.3, -0.2, 1.0)), Vec3(1.0, 2.0, 9.0), 0.005, n);

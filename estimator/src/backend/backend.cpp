@@ -10,6 +10,7 @@
 #include "evio/estimator/backend/imu_propagation.h"
 #include "evio/estimator/backend/range_update.h"
 #include "evio/estimator/backend/static_initializer.h"
+#include "evio/estimator/backend/visual_models.h"
 
 namespace evio::estimator {
 namespace {
@@ -365,13 +366,8 @@ BackendEstimate Backend::makeEstimate() const {
     J.block<3, 3>(0, kIdxP).setIdentity();
     J.block<3, 3>(3, kIdxTheta).setIdentity();
     e.cov_pose_B = J * e.cov_imu * J.transpose();
-    // Camera pose error: δp_C = δp − R_W_B [p_B_C]x δθ,  δθ_C = R_C_B δθ.
-    const Mat3 R = state_.imu.q_W_B.toRotationMatrix();
-    const Mat3 R_B_C = sensors_.T_B_C.rotation();
-    Eigen::Matrix<double, 6, 15> Jc = Eigen::Matrix<double, 6, 15>::Zero();
-    Jc.block<3, 3>(0, kIdxP).setIdentity();
-    Jc.block<3, 3>(0, kIdxTheta) = -R * so3::hat(sensors_.T_B_C.translation());
-    Jc.block<3, 3>(3, kIdxTheta) = R_B_C.transpose();
+    Eigen::Matrix<double, 6, 15> Jc;
+    cameraPose(state_.imu, sensors_.T_B_C, &Jc);
     e.cov_pose_C = Jc * e.cov_imu * Jc.transpose();
   }
   e.num_clones = static_cast<int>(state_.clones.size());

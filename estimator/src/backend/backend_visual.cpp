@@ -8,25 +8,21 @@
 #include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/triangulation.h"
+#include "evio/estimator/backend/visual_models.h"
 
 namespace evio::estimator {
 
 void Backend::augmentClone() {
-  // T_W_C = T_W_B T_B_C;  δp_C = δp − R_W_B [p_B_C]x δθ,  δθ_C = R_C_B δθ  (R_W_C = R_W_B Exp(δθ) R_B_C).
-  const Mat3 R = state_.imu.q_W_B.toRotationMatrix();
-  const Pose T_W_C = state_.imu.T_W_B() * sensors_.T_B_C;
+  Eigen::Matrix<double, 6, 15> J_imu;
+  const Pose T_W_C = cameraPose(state_.imu, sensors_.T_B_C, &J_imu);
   CameraClone clone;
   clone.id = next_clone_id_++;
   clone.t_ns = state_.imu.t_ns;
-  clone.p_W_C = T_W_C.translation();
-  clone.q_W_C = T_W_C.quaternion();
-  clone.p_fej = clone.p_W_C;
-  clone.q_fej = clone.q_W_C;
+  clone.p_W_C = clone.p_fej = T_W_C.translation();
+  clone.q_W_C = clone.q_fej = T_W_C.quaternion();
   Eigen::Matrix<double, kCloneDim, Eigen::Dynamic> J = Eigen::Matrix<double, kCloneDim, Eigen::Dynamic>::Zero(
       kCloneDim, state_.dim());
-  J.block<3, 3>(kCloneP, kIdxP).setIdentity();
-  J.block<3, 3>(kCloneP, kIdxTheta) = -R * so3::hat(sensors_.T_B_C.translation());
-  J.block<3, 3>(kCloneTheta, kIdxTheta) = sensors_.T_B_C.rotation().transpose();
+  J.leftCols<kImuDim>() = J_imu;
   state_.addClone(clone, J);
 }
 

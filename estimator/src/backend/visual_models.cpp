@@ -10,6 +10,16 @@ bool inFront(const Vec3& h) { return h.allFinite() && h.z() > kMinDepthRatio * h
 
 }  // namespace
 
+Pose cameraPose(const ImuState& imu, const Pose& T_B_C, Eigen::Matrix<double, 6, 15>* d_cam_d_imu) {
+  if (d_cam_d_imu != nullptr) {
+    d_cam_d_imu->setZero();
+    d_cam_d_imu->block<3, 3>(kCloneP, kIdxP).setIdentity();
+    d_cam_d_imu->block<3, 3>(kCloneP, kIdxTheta) = -imu.q_W_B.toRotationMatrix() * so3::hat(T_B_C.translation());
+    d_cam_d_imu->block<3, 3>(kCloneTheta, kIdxTheta) = T_B_C.rotation().transpose();
+  }
+  return imu.T_W_B() * T_B_C;
+}
+
 bool projectWorldPoint(const CameraClone& clone, const Vec3& p_W, Vec2* z, Mat26* d_z_d_clone,
                        Mat23* d_z_d_p_W) {
   const Mat3 Rt = clone.R_W_C().transpose();

@@ -13,6 +13,7 @@
 ///    which stays well defined as ρ → 0 (a point at infinity).
 
 #include "evio/core/eigen_types.h"
+#include "evio/core/pose.h"
 #include "evio/estimator/backend/filter_state.h"
 
 namespace evio::estimator {
@@ -23,6 +24,11 @@ using Mat36 = Eigen::Matrix<double, 3, 6>;
 /// Points closer to the image plane than this (h_z <= kMinDepthRatio · |h|)
 /// are treated as not projectable.
 inline constexpr double kMinDepthRatio = 1e-3;
+
+/// The camera pose T_W_C = T_W_B T_B_C of an IMU state and its Jacobian with
+/// respect to the IMU error state (15 columns, filter_state.h order):
+///   δp_C = δp − R_W_B [p_B_C]x δθ,   δθ_C = R_C_B δθ   (R_W_C = R_W_B Exp(δθ) R_B_C).
+Pose cameraPose(const ImuState& imu, const Pose& T_B_C, Eigen::Matrix<double, 6, 15>* d_cam_d_imu = nullptr);
 
 /// Normalised projection of world point p_W into `clone`. Jacobians:
 /// ∂z/∂[δp_W_C; δθ_C] (2×6) and ∂z/∂p_W (2×3). False when the point is not in

@@ -9,6 +9,7 @@ namespace evio::apps {
 
 void addInfoCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
 void addTrackCommand(CLI::App& app);
 void addEvaluateTracksCommand(CLI::App& app);
 void addEvaluateCommand(CLI::App& app);
@@ -16,5 +17,6 @@ void addCampaignCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
+void addEstimateCommand(CLI::App& app);
 
 }  // namespace evio::apps

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "evio 0.1.0");
   evio::apps::addInfoCommand(app);
   evio::apps::addTrajectoryCommand(app);
+  evio::apps::addRenderCommand(app);
   evio::apps::addTrackCommand(app);
   evio::apps::addEvaluateTracksCommand(app);
   evio::apps::addEvaluateCommand(app);
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   evio::apps::addReportCommand(app);
   evio::apps::addExportCommand(app);
   evio::apps::addSimulateCommand(app);
+  evio::apps::addEstimateCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "evio/core/error.h"
 #include "evio/core/io/config.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "progress_line.h"
@@ -48,8 +49,8 @@ void addEstimateCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("estimate", "Run EKLT-VIO, KLT-VIO or the backend on tracks over a sequence");
   cmd->add_option("sequence", args->folder, "sequence folder (Event-Camera Dataset layout)")->required();
-  cmd->add_option("--method", args->method, "eklt-vio, klt-vio or tracks")
-      ->required()
+  cmd->add_option("--method", args->method,
+                  "eklt-vio, klt-vio or tracks (default: the `method` key of --config/--set)")
       ->check(CLI::IsMember({"eklt-vio", "klt-vio", "tracks"}));
   cmd->add_option("--config", args->config,
                   "options YAML (estimator/config/*.yaml; keys: frontend, sync, backend, init, calibration, tracks, "
@@ -65,6 +66,18 @@ void addEstimateCommand(CLI::App& app) {
     config::Document doc =
         args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(resolveConfig(args->config));
     for (const auto& o : args->overrides) config::applyOverride(doc, o);
+    // --method wins; else the configuration's `method` (campaign methods set
+    // it with --set, e.g. an eklt-vio variant on reconstructed frames).
+    if (args->method.empty()) {
+      const YAML::Node m = doc.root.IsMap() ? doc.root["method"] : YAML::Node();
+      if (!m.IsDefined() || !m.IsScalar())
+        throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|tracks or method: in " +
+                    (args->config.empty() ? std::string("--set") : args->config));
+      args->method = config::detail::scalarAs<std::string>(doc, m, "method");
+      if (args->method != "eklt-vio" && args->method != "klt-vio" && args->method != "tracks")
+        throw Error(config::where(doc, m, "method") + ": must be eklt-vio, klt-vio or tracks (got '" +
+                    args->method + "')");
+    }
     config::applyOverride(doc, "method=" + args->method);
     if (!args->tracks.empty()) config::applyOverride(doc, "tracks.file=" + args->tracks);
     if (args->track_noise_px >= 0.0) config::applyOverride(doc, "tracks.noise_px=" + std::to_string(args->track_noise_px));

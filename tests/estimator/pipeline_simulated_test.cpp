@@ -45,7 +45,7 @@ class PipelineSimulated : public ::testing::Test {
   static std::string sequence() { return dir_->file("poster"); }
 
   static void runAndCheck(PipelineOptions options, const std::string& name, std::uint64_t min_poses) {
-    options.backend.slam_min_depth_m = 0.5;  // the poster is about 1 m away (estimator/config/sim_davis240c.yaml)
+    options.backend.slam_min_depth_m = 0.5;  // the poster is about 1 m away (estimator/config/sim.yaml)
     const std::string out = dir_->file(name);
     const PipelineResult r = runPipeline(sequence(), options, out);
     EXPECT_TRUE(r.status.ok()) << name << ": " << r.status.cause;

@@ -113,6 +113,24 @@ TEST(Pipeline, SameInputSameSeedGivesIdenticalTrajectories) {
   EXPECT_NE(io::readFile(dir.file("a/trajectory.txt")), io::readFile(dir.file("c/trajectory.txt")));
 }
 
+TEST(Pipeline, NormalisedImageNoiseEqualsPixelNoiseOverTheFocalLength) {
+  // The tiny camera has f = 200 px: σ = 1 px is 0.005 in normalised units.
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 2.0;
+  writeTinySequence(seq, so);
+  runPipeline(seq, tracksOptions(), dir.file("px"));
+  PipelineOptions normalised = tracksOptions();
+  normalised.backend.sigma_img_px = 123.0;  // ignored when sigma_img_normalized > 0
+  normalised.backend.sigma_img_normalized = 1.0 / 200.0;
+  runPipeline(seq, normalised, dir.file("norm"));
+  EXPECT_EQ(io::readFile(dir.file("px/trajectory_covariance.txt")), io::readFile(dir.file("norm/trajectory_covariance.txt")));
+  normalised.backend.sigma_img_normalized = 2.0 / 200.0;
+  runPipeline(seq, normalised, dir.file("norm2"));
+  EXPECT_NE(io::readFile(dir.file("px/trajectory_covariance.txt")), io::readFile(dir.file("norm2/trajectory_covariance.txt")));
+}
+
 TEST(Pipeline, CalibTxtFolderTakesTheRestFromTheConfiguration) {
   test::TempDir dir;
   const std::string seq = dir.file("seq");

@@ -41,7 +41,9 @@ Backend::Backend(const BackendOptions& options, const BackendSensors& sensors)
   noise_ = options_.imuNoise(sensors_.imu);
   g_W_ = Vec3(0.0, 0.0, -sensors_.gravity_mps2);
   const Vec4 k = sensors_.camera.intrinsics();
-  sigma_z_ = options_.sigma_img_px / (0.5 * (k(0) + k(1)));
+  // σ_z in normalised image coordinates: σ_img_px / mean focal length (px).
+  sigma_z_ = options_.sigma_img_normalized > 0.0 ? options_.sigma_img_normalized
+                                                 : options_.sigma_img_px / (0.5 * (k(0) + k(1)));
 }
 
 // --- initialisation --------------------------------------------------------------------

@@ -10,6 +10,7 @@ void BackendOptions::validate() const {
   requireField(window_size >= 2, "window_size", "must be >= 2");
   requireField(max_slam_features >= 0, "max_slam_features", "must be >= 0");
   requirePositive("sigma_img_px", sigma_img_px);
+  requireNonNegative("sigma_img_normalized", sigma_img_normalized);
   requireNonNegative("accelerometer_noise_density", accelerometer_noise_density);
   requireNonNegative("accelerometer_random_walk", accelerometer_random_walk);
   requireNonNegative("gyroscope_noise_density", gyroscope_noise_density);

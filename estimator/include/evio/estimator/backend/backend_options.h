@@ -22,6 +22,9 @@ struct BackendOptions {
   /// Image measurement noise σ_img in pixels, converted to normalised units by
   /// the mean focal length (σ_img / f). xVIO's 0.025 normalised ≈ 5 px at f ≈ 200 px.
   double sigma_img_px = 5.0;
+  /// σ_img in normalised image coordinates (xVIO's unit); when > 0 it replaces
+  /// sigma_img_px, so one setting serves cameras of any focal length.
+  double sigma_img_normalized = 0.0;
 
   // IMU -------------------------------------------------------------------------
   /// Take the IMU noise densities from the rig (sensors.yaml) instead of the fields below.
@@ -108,6 +111,7 @@ struct BackendOptions {
     v("window_size", window_size, "M: camera poses in the sliding window");
     v("max_slam_features", max_slam_features, "N: SLAM features in the state");
     v("sigma_img_px", sigma_img_px, "image measurement noise, px");
+    v("sigma_img_normalized", sigma_img_normalized, "if > 0: image noise in normalised units (replaces sigma_img_px)");
     v("use_rig_imu_noise", use_rig_imu_noise, "IMU noise from sensors.yaml");
     v("accelerometer_noise_density", accelerometer_noise_density, "m/s^2/sqrt(Hz)");
     v("accelerometer_random_walk", accelerometer_random_walk, "m/s^3/sqrt(Hz)");

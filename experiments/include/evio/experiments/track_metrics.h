@@ -16,6 +16,13 @@
 /// the start offset is not counted as error). Ground truth is interpolated linearly in time between
 /// its samples; gaps longer than max_gap_s (occlusion) are not bridged, and
 /// an estimated track is scored only while the ground truth covers it.
+///
+/// The depth mode (the second evaluateTracks) needs no ground-truth tracks:
+/// every estimated track gets its own truth from the depth map at its start
+/// and the ground-truth poses (depth_track_truth.h), so tracks born anywhere
+/// at any frame can be scored; tracks with no truth (not starting at a depth
+/// stamp, or on a depth discontinuity or no surface) are counted as
+/// unevaluable.
 
 #include <cstdint>
 #include <string>
@@ -23,6 +30,7 @@
 
 #include "evio/core/io/tracks_txt.h"
 #include "evio/core/options.h"
+#include "evio/experiments/depth_track_truth.h"
 
 namespace evio::experiments {
 
@@ -59,8 +67,15 @@ struct AliveSample {
 };
 
 struct TrackMetrics {
+  std::string mode;                    ///< "tracks-nearest", "tracks-id" or "depth"
   std::uint64_t estimated_tracks = 0;
-  std::uint64_t matched_tracks = 0;
+  std::uint64_t matched_tracks = 0;    ///< tracks with a truth (evaluable)
+  std::uint64_t unevaluable_tracks = 0;          ///< estimated_tracks − matched_tracks
+  std::uint64_t unevaluable_no_depth_frame = 0;  ///< depth: first sample not at a depth stamp
+  std::uint64_t unevaluable_depth = 0;           ///< depth: no surface or a discontinuity at the start
+  std::uint64_t ended_by_error = 0;    ///< scored life ended by the error passing max_error_px
+  std::uint64_t ended_by_truth = 0;    ///< ... by the truth ending (out of view, occluded)
+  std::uint64_t ended_by_track = 0;    ///< ... by the estimated track ending
   std::uint64_t scored_samples = 0;
   double mean_error_px = 0.0;          ///< over scored samples (before the error passes the limit)
   double median_error_px = 0.0;
@@ -73,6 +88,13 @@ struct TrackMetrics {
 
 /// Scores `estimated` against `truth`. Throws evio::Error for bad options.
 TrackMetrics evaluateTracks(const std::vector<io::TrackSample>& estimated, const std::vector<io::TrackSample>& truth,
+                            const TrackMetricsOptions& options);
+
+/// Scores `estimated` against the truth of each track from depth maps and
+/// poses (the alive count's "truth" is then the number of evaluable tracks
+/// between their first sample and the end of their truth). Throws
+/// evio::Error for bad options and unreadable depth maps.
+TrackMetrics evaluateTracks(const std::vector<io::TrackSample>& estimated, const DepthTrackTruth& truth,
                             const TrackMetricsOptions& options);
 
 /// The summary and both tables as one JSON object.

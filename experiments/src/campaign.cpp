@@ -170,7 +170,7 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
     for (std::size_t i = 0; i < scenarios.size(); ++i) {
       const std::string p = "scenarios[" + std::to_string(i) + "]";
       const YAML::Node s = scenarios[i];
-      checkKeys(doc, s, p, {"name", "file", "sequence", "set"});
+      checkKeys(doc, s, p, {"name", "file", "sequence", "set", "estimate_set"});
       CampaignScenario sc;
       sc.name = name(doc, s["name"], p + ".name");
       if (!names.insert(sc.name).second) throwAt(doc, s["name"], p + ".name", "duplicate scenario name");
@@ -182,6 +182,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
         if (seq.IsDefined()) throwAt(doc, set, p + ".set", "a recorded sequence takes no simulate overrides");
         flattenOverrides(doc, set, p + ".set", "", sc.set);
       }
+      if (const YAML::Node set = optional(s, "estimate_set"); set.IsDefined())
+        flattenOverrides(doc, set, p + ".estimate_set", "", sc.estimate_set);
       c.scenarios.push_back(sc);
     }
 
@@ -290,7 +292,9 @@ std::vector<Job> expandJobs(const Campaign& c) {
           j.method = m;
           j.seed = seed;
           j.simulate_set = c.scenarios[s].set;
-          j.estimate_set = c.methods[m].set;
+          // The scenario's estimator settings first, so that a method may override them.
+          j.estimate_set = c.scenarios[s].estimate_set;
+          j.estimate_set.insert(j.estimate_set.end(), c.methods[m].set.begin(), c.methods[m].set.end());
           j.evaluate_set = c.evaluate;
           for (std::size_t a = 0; a < c.sweeps.size(); ++a) {
             const auto& axis = c.sweeps[a];

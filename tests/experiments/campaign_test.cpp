@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include "evio/core/error.h"
@@ -83,6 +84,29 @@ TEST(Campaign, ExpandsTheMatrixWithStableUniqueIds) {
   // Overrides from the command line apply before expansion.
   EXPECT_EQ(expandJobs(loadCampaign(dir.file("c.yaml"), {"seeds=[7]"})).size(), 8u);
   EXPECT_EQ(expandJobs(loadCampaign(dir.file("c.yaml"), {"seeds={first: 10, count: 5}"})).size(), 40u);
+}
+
+TEST(Campaign, ScenarioEstimateSettingsComeBeforeTheMethods) {
+  test::TempDir dir;
+  io::writeFileAtomic(dir.file("c.yaml"), R"(name: tuned
+seeds: [1]
+scenarios:
+  - {name: near, file: near.yaml}
+  - {name: far, file: far.yaml, estimate_set: {backend: {slam_min_depth_m: 5}, sync.n_e: 9000}}
+methods:
+  - plain
+  - name: fast
+    set: {sync.n_e: 500}
+)");
+  const auto jobs = expandJobs(loadCampaign(dir.file("c.yaml")));
+  ASSERT_EQ(jobs.size(), 4u);
+  std::map<std::string, std::string> by_cell;
+  for (const auto& j : jobs) by_cell[j.id.substr(0, j.id.find(".s1."))] = overridesText(j.estimate_set);
+  EXPECT_EQ(by_cell["near.plain"], "");
+  EXPECT_EQ(by_cell["near.fast"], "sync.n_e=500");
+  // Applied in order, so the method's n_e wins over the scenario's.
+  EXPECT_EQ(by_cell["far.plain"], "backend.slam_min_depth_m=5;sync.n_e=9000");
+  EXPECT_EQ(by_cell["far.fast"], "backend.slam_min_depth_m=5;sync.n_e=9000;sync.n_e=500");
 }
 
 TEST(Campaign, RejectsBadFilesWithFileAndLine) {

@@ -12,6 +12,7 @@
 ///     - name: hover
 ///       file: ../scenarios/hover.yaml
 ///       set: {duration_s: 30}        # optional overrides for the simulate step
+///       estimate_set: {backend.slam_min_depth_m: 5}   # optional estimate overrides for this scenario
 ///     - name: recorded
 ///       sequence: /data/boxes_6dof   # an existing sequence folder: no simulate
 ///   methods:
@@ -62,6 +63,7 @@ struct CampaignScenario {
   std::string file;      ///< scenario file (absolute), for simulated scenarios
   std::string sequence;  ///< existing sequence folder (absolute), for recorded ones
   Overrides set;         ///< simulate overrides
+  Overrides estimate_set;  ///< estimate overrides for this scenario (before the method's), e.g. the depth prior
 };
 
 struct CampaignMethod {

@@ -10,7 +10,8 @@
 //                  point light) per hit pixel, nothing else: the same tiles,
 //                  ray streams (rtcIntersect1M/rtcOccluded1M, coherent flag)
 //                  and thread count as the renderer, no shading, no output;
-//   BM_Render      the full renderer (radiance, depth, normal; no flow).
+//   BM_Render      the full renderer (radiance, depth, normal; no flow), into
+//                  output images reused from frame to frame.
 // The benchmark argument is the thread count (1 and 2). Counters:
 //   rays_per_s_per_core  camera + occlusion rays traced per second of process
 //                        CPU time (CLOCK_PROCESS_CPUTIME_ID), i.e. per busy
@@ -189,9 +190,10 @@ void render(benchmark::State& state, std::string preset, int w, int h) {
   const evio::Pose T = evio::simulator::previewPose(s.description());
   double rays = 0.0;
   const double cpu0 = processCpuS();
+  evio::simulator::RenderOutput out;  // reused from frame to frame, as the simulator does
   for (auto _ : state) {
     evio::simulator::RenderStats stats;
-    auto out = renderer.render(T, nullptr, &stats);
+    renderer.render(T, nullptr, &out, &stats);
     benchmark::DoNotOptimize(out.radiance.data);
     rays += static_cast<double>(stats.camera_rays + stats.shadow_rays);
   }

@@ -27,48 +27,10 @@ MipMap::MipMap(const cv::Mat& image, bool repeat) : repeat_(repeat) {
       }
     levels_.push_back(b);
   }
-}
-
-float MipMap::bilinear(int level, float s, float t) const {
-  const cv::Mat& m = levels_[static_cast<std::size_t>(level)];
-  // Level-0 coordinates to this level's, texel centres at integers.
-  const float x = s * static_cast<float>(m.cols) / static_cast<float>(levels_[0].cols) - 0.5f;
-  const float y = t * static_cast<float>(m.rows) / static_cast<float>(levels_[0].rows) - 0.5f;
-  const float fx0 = std::floor(x), fy0 = std::floor(y);
-  const float fx = x - fx0, fy = y - fy0;
-  int x0 = static_cast<int>(fx0), y0 = static_cast<int>(fy0);
-  int x1 = x0 + 1, y1 = y0 + 1;
-  if (repeat_) {
-    const auto wrap = [](int i, int n) {
-      i %= n;
-      return i < 0 ? i + n : i;
-    };
-    x0 = wrap(x0, m.cols);
-    x1 = wrap(x1, m.cols);
-    y0 = wrap(y0, m.rows);
-    y1 = wrap(y1, m.rows);
-  } else {
-    x0 = std::clamp(x0, 0, m.cols - 1);
-    x1 = std::clamp(x1, 0, m.cols - 1);
-    y0 = std::clamp(y0, 0, m.rows - 1);
-    y1 = std::clamp(y1, 0, m.rows - 1);
-  }
-  const float* r0 = m.ptr<float>(y0);
-  const float* r1 = m.ptr<float>(y1);
-  const float a = r0[x0] + fx * (r0[x1] - r0[x0]);
-  const float b = r1[x0] + fx * (r1[x1] - r1[x0]);
-  return a + fy * (b - a);
-}
-
-float MipMap::sample(float s, float t, float footprint) const {
-  if (!(footprint > 1.0f)) return bilinear(0, s, t);
-  const float lambda = std::log2(footprint);
-  const int top = levels() - 1;
-  const int l0 = std::min(static_cast<int>(lambda), top);
-  if (l0 >= top) return bilinear(top, s, t);
-  const float f = lambda - static_cast<float>(l0);
-  const float a = bilinear(l0, s, t);
-  return a + f * (bilinear(l0 + 1, s, t) - a);
+  for (const cv::Mat& m : levels_)
+    table_.push_back(Level{m.data, m.step[0], m.cols, m.rows, static_cast<float>(m.cols), static_cast<float>(m.rows)});
+  fcols0_ = table_[0].fcols;
+  frows0_ = table_[0].frows;
 }
 
 }  // namespace evio::scenes

@@ -26,8 +26,6 @@ namespace evio::scenes {
 
 namespace {
 
-constexpr float kPi = std::numbers::pi_v<float>;
-
 double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -88,6 +86,7 @@ Scene::Scene(const SceneDescription& description, const SceneBuildOptions& optio
   stats_.generate_s = secondsSince(t0);
   t0 = std::chrono::steady_clock::now();
   buildEmbree(options);
+  buildShadeMeshes();
   stats_.bvh_s = secondsSince(t0);
   if (o.indirect.bounces > 0) {
     t0 = std::chrono::steady_clock::now();
@@ -183,6 +182,24 @@ void Scene::generate(const SceneBuildOptions& /*options*/) {
   }
 }
 
+void Scene::buildShadeMeshes() {
+  shade_.resize(meshes_.size());
+  for (std::size_t g = 0; g < meshes_.size(); ++g) {
+    const TriangleMesh& m = meshes_[g].mesh;  // indices checked by buildEmbree
+    ShadeMesh& s = shade_[g];
+    s.vertices.resize(m.positions.size());
+    for (std::size_t i = 0; i < m.positions.size(); ++i)
+      s.vertices[i] = ShadeVertex{m.positions[i], m.normals[i], m.uvs[i]};
+    s.triangles.resize(m.triangles.size());
+    for (std::size_t i = 0; i < m.triangles.size(); ++i) {
+      const Eigen::Vector3i& t = m.triangles[i];
+      s.triangles[i] = ShadeTriangle{{static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+                                      static_cast<std::uint32_t>(t[2])},
+                                     meshes_[g].face_normals[i]};
+    }
+  }
+}
+
 void Scene::buildEmbree(const SceneBuildOptions& options) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw Error("Embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
@@ -225,102 +242,6 @@ void Scene::buildEmbree(const SceneBuildOptions& options) {
   if (e != RTC_ERROR_NONE) throw Error("Embree: building the scene failed (error " + std::to_string(e) + ")");
 }
 
-void Scene::surfaceHit(unsigned geom, unsigned prim, float u, float v, const Eigen::Vector3f& dir,
-                       SurfaceHit* hit) const {
-  const SceneMesh& sm = meshes_[geom];
-  const TriangleMesh& m = sm.mesh;
-  const Eigen::Vector3i& t = m.triangles[prim];
-  const auto i0 = static_cast<std::size_t>(t[0]), i1 = static_cast<std::size_t>(t[1]),
-             i2 = static_cast<std::size_t>(t[2]);
-  const float w0 = 1.0f - u - v;
-  SurfaceHit& h = *hit;
-  h.mesh = geom;
-  h.prim = prim;
-  h.b1 = u;
-  h.b2 = v;
-  const Eigen::Vector3f& p0 = m.positions[i0];
-  h.p = w0 * p0 + u * m.positions[i1] + v * m.positions[i2];
-  Eigen::Vector3f ng = sm.face_normals[prim];
-  if (ng.x() == 0.0f && ng.y() == 0.0f && ng.z() == 0.0f) ng = -dir;  // degenerate triangle
-  Eigen::Vector3f n = w0 * m.normals[i0] + u * m.normals[i1] + v * m.normals[i2];
-  const float nlen2 = n.squaredNorm();
-  n = nlen2 > 0.0f ? Eigen::Vector3f(n * (1.0f / std::sqrt(nlen2))) : ng;
-  h.back_face = ng.dot(dir) > 0.0f;
-  if (h.back_face) {
-    ng = -ng;
-    n = -n;
-  }
-  if (n.dot(dir) >= 0.0f) n = ng;  // a shading normal facing away from the viewer
-  h.n = n;
-  h.ng = ng;
-  h.uv = w0 * m.uvs[i0] + u * m.uvs[i1] + v * m.uvs[i2];
-}
-
-float Scene::albedo(const SurfaceHit& hit, float footprint_m) const {
-  const auto& mat = materials_[static_cast<std::size_t>(meshes_[hit.mesh].material)];
-  return mat.texture->evaluate(hit.p, hit.uv, footprint_m);
-}
-
-void Scene::lightFrom(const SurfaceHit& hit, int k, Eigen::Vector3f* wi, float* e_normal) const {
-  const DirectLight& d = direct_[static_cast<std::size_t>(k)];
-  if (d.kind == 0) {
-    *wi = d.vec;
-    *e_normal = d.power;
-    return;
-  }
-  const Eigen::Vector3f to = d.vec - hit.p;
-  const float d2 = to.squaredNorm();
-  if (!(d2 > 0.0f)) {
-    *e_normal = 0.0f;
-    *wi = hit.n;
-    return;
-  }
-  *wi = to / std::sqrt(d2);
-  float e = d.power / d2;
-  if (d.kind == 2) {
-    const float c = -wi->dot(d.axis);
-    float t = (c - d.cos_outer) / (d.cos_inner - d.cos_outer);
-    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-    e *= t * t * (3.0f - 2.0f * t);
-  }
-  *e_normal = e;
-}
-
-bool Scene::shadowRay(int k, const SurfaceHit& hit, ShadowRay* ray) const {
-  Eigen::Vector3f wi;
-  float e = 0.0f;
-  lightFrom(hit, k, &wi, &e);
-  if (!(e > 0.0f) || hit.ng.dot(wi) <= 0.0f || hit.n.dot(wi) <= 0.0f) return false;
-  const float eps = 5e-5f * (1.0f + hit.p.cwiseAbs().maxCoeff());
-  ray->origin = hit.p + eps * hit.ng;
-  ray->direction = wi;
-  ray->e_normal = e;
-  const DirectLight& d = direct_[static_cast<std::size_t>(k)];
-  ray->t_far = d.kind == 0 ? std::numeric_limits<float>::infinity()
-                           : (d.vec - ray->origin).norm() * (1.0f - 1e-5f);
-  return true;
-}
-
-float Scene::radiance(const SurfaceHit& hit, const Eigen::Vector3f& to_viewer, float albedo,
-                      const LightSample* lights) const {
-  const Reflectance& refl = materials_[static_cast<std::size_t>(meshes_[hit.mesh].material)].reflectance;
-  const float c_o = hit.n.dot(to_viewer);
-  float l = 0.0f;
-  for (int k = 0; k < static_cast<int>(direct_.size()); ++k) {
-    const LightSample& s = lights[k];
-    if (!(s.e_normal > 0.0f)) continue;
-    const float c_i = hit.n.dot(s.wi);
-    if (c_i <= 0.0f) continue;
-    l += refl.brdfOverAlbedo(s.wi, to_viewer, c_i, c_o) * s.e_normal * c_i;
-  }
-  float e_amb;
-  if (indirect_on_) e_amb = interpolate(hit, indirect_);
-  else e_amb = kPi * sky_radiance_ * 0.5f * (1.0f + hit.n.z());
-  return albedo * (l + e_amb * (1.0f / kPi));
-}
-
-float Scene::background(const Eigen::Vector3f& dir) const { return dir.z() > 0.0f ? sky_radiance_ : 0.0f; }
-
 float Scene::directIrradiance(const SurfaceHit& hit) const {
   float e_sum = 0.0f;
   for (int k = 0; k < static_cast<int>(direct_.size()); ++k) {
@@ -337,15 +258,6 @@ float Scene::directIrradiance(const SurfaceHit& hit) const {
     e_sum += e * hit.n.dot(wi);
   }
   return e_sum;
-}
-
-float Scene::interpolate(const SurfaceHit& hit, const std::vector<std::vector<float>>& cache) const {
-  if (cache.empty()) return 0.0f;
-  const auto& values = cache[hit.mesh];
-  if (values.empty()) return 0.0f;
-  const Eigen::Vector3i& t = meshes_[hit.mesh].mesh.triangles[hit.prim];
-  return (1.0f - hit.b1 - hit.b2) * values[static_cast<std::size_t>(t[0])] +
-         hit.b1 * values[static_cast<std::size_t>(t[1])] + hit.b2 * values[static_cast<std::size_t>(t[2])];
 }
 
 void Scene::checkViewpoint(const Vec3& p_W) const {

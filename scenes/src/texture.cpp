@@ -185,27 +185,4 @@ float Texture::shapes(const Eigen::Vector2f& uv, float footprint, float backgrou
   return value;
 }
 
-float Texture::evaluate(const Eigen::Vector3f& p_W, const Eigen::Vector2f& uv_m, float footprint_m) const {
-  switch (kind_) {
-    case Kind::kConstant: return static_cast<float>(options_.value);
-    case Kind::kChecker: {
-      const float sq = static_cast<float>(options_.square_m);
-      const long long i = static_cast<long long>(std::floor(uv_m.x() / sq)) +
-                          static_cast<long long>(std::floor(uv_m.y() / sq));
-      return static_cast<float>((i & 1LL) ? options_.value_b : options_.value);
-    }
-    case Kind::kNoise: return noise(p_W, footprint_m);
-    case Kind::kImage: return image(uv_m, footprint_m);
-    case Kind::kShapes:
-    case Kind::kCollage: {
-      const float s = uv_m.x() / texel_m_, t = uv_m.y() / texel_m_;
-      if (s < 0.0f || t < 0.0f || s > static_cast<float>(mip_.level(0).cols) ||
-          t > static_cast<float>(mip_.level(0).rows))
-        return static_cast<float>(options_.background);
-      return mip_.sample(s, t, footprint_m / texel_m_);
-    }
-  }
-  return 0.0f;
-}
-
 }  // namespace evio::scenes

@@ -3,19 +3,16 @@
 #include <cmath>
 #include <numbers>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <Eigen/Geometry>
 
 #include "evio/core/random_stream.h"
 
 namespace evio::noise {
 
-namespace {
-inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
-inline int floorInt(float x) {
-  const int i = static_cast<int>(x);
-  return (x < static_cast<float>(i)) ? i - 1 : i;
-}
-}  // namespace
 
 ValueLattice::ValueLattice(std::uint64_t seed) : v_(static_cast<std::size_t>(kSize * kSize * kSize)) {
   RandomStream rng(seed, "value lattice");
@@ -32,26 +29,77 @@ ValueLattice::ValueLattice(std::uint64_t seed) : v_(static_cast<std::size_t>(kSi
                                                            static_cast<float>(rng.uniform(0.0, kSize)),
                                                            static_cast<float>(rng.uniform(0.0, kSize)));
   }
+  for (std::size_t o = 0; o < static_cast<std::size_t>(kMaxOctaves); ++o)
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) rotation_soa_[static_cast<std::size_t>(3 * i + j)][o] = rotation_[o](i, j);
+      offset_soa_[static_cast<std::size_t>(i)][o] = offset_[o][i];
+    }
 }
 
-float ValueLattice::value(const Eigen::Vector3f& p) const {
-  const int ix = floorInt(p.x()), iy = floorInt(p.y()), iz = floorInt(p.z());
-  const float u = fade(p.x() - static_cast<float>(ix));
-  const float v = fade(p.y() - static_cast<float>(iy));
-  const float w = fade(p.z() - static_cast<float>(iz));
-  constexpr int m = kSize - 1;
-  const int x0 = ix & m, x1 = (ix + 1) & m;
-  const int y0 = (iy & m) * kSize, y1 = ((iy + 1) & m) * kSize;
-  const int z0 = (iz & m) * kSize * kSize, z1 = ((iz + 1) & m) * kSize * kSize;
+void ValueLattice::octaveValues(const Eigen::Vector3f& p, int count, float* out) const {
+#if defined(__SSE2__)
+  const __m128 px = _mm_set1_ps(p.x()), py = _mm_set1_ps(p.y()), pz = _mm_set1_ps(p.z());
+  const __m128i m = _mm_set1_epi32(kSize - 1), one = _mm_set1_epi32(1);
   const std::int8_t* t = v_.data();
-  const auto at = [t](int i) { return static_cast<float>(t[i]); };
-  const float a00 = at(z0 + y0 + x0) + u * (at(z0 + y0 + x1) - at(z0 + y0 + x0));
-  const float a10 = at(z0 + y1 + x0) + u * (at(z0 + y1 + x1) - at(z0 + y1 + x0));
-  const float a01 = at(z1 + y0 + x0) + u * (at(z1 + y0 + x1) - at(z1 + y0 + x0));
-  const float a11 = at(z1 + y1 + x0) + u * (at(z1 + y1 + x1) - at(z1 + y1 + x0));
-  const float b0 = a00 + v * (a10 - a00);
-  const float b1 = a01 + v * (a11 - a01);
-  return (b0 + w * (b1 - b0)) * (1.0f / 127.0f);
+  for (int g = 0; g < count; g += 4) {
+    const auto row = [g](const std::array<float, kMaxOctaves>& r) { return _mm_load_ps(r.data() + g); };
+    __m128 q[3];
+    for (int i = 0; i < 3; ++i)  // (R p)_i + t_i, summed in Eigen's order: (r_i0 x + (r_i1 y + r_i2 z)) + t_i
+      q[i] = _mm_add_ps(_mm_add_ps(_mm_mul_ps(row(rotation_soa_[static_cast<std::size_t>(3 * i)]), px),
+                                   _mm_add_ps(_mm_mul_ps(row(rotation_soa_[static_cast<std::size_t>(3 * i + 1)]), py),
+                                              _mm_mul_ps(row(rotation_soa_[static_cast<std::size_t>(3 * i + 2)]), pz))),
+                        row(offset_soa_[static_cast<std::size_t>(i)]));
+    __m128i lo[3], hi[3];
+    __m128 f[3];
+    for (int i = 0; i < 3; ++i) {
+      // detail::floorInt, then detail::fade(x - float(ix)).
+      __m128i ix = _mm_cvttps_epi32(q[i]);
+      ix = _mm_add_epi32(ix, _mm_castps_si128(_mm_cmplt_ps(q[i], _mm_cvtepi32_ps(ix))));  // -1 where x < int(x)
+      const __m128 x = _mm_sub_ps(q[i], _mm_cvtepi32_ps(ix));
+      const __m128 a = _mm_mul_ps(_mm_mul_ps(x, x), x);
+      const __m128 b = _mm_add_ps(_mm_mul_ps(x, _mm_sub_ps(_mm_mul_ps(x, _mm_set1_ps(6.0f)), _mm_set1_ps(15.0f))),
+                                  _mm_set1_ps(10.0f));
+      f[i] = _mm_mul_ps(a, b);
+      lo[i] = _mm_and_si128(ix, m);
+      hi[i] = _mm_and_si128(_mm_add_epi32(ix, one), m);
+    }
+    // Row (y · kSize) and slice (z · kSize²) offsets.
+    lo[1] = _mm_slli_epi32(lo[1], 6);
+    hi[1] = _mm_slli_epi32(hi[1], 6);
+    lo[2] = _mm_slli_epi32(lo[2], 12);
+    hi[2] = _mm_slli_epi32(hi[2], 12);
+    static_assert(kSize == 64, "the shifts above assume a 64-cell lattice");
+    alignas(16) std::int32_t x0[4], x1[4], y0[4], y1[4], z0[4], z1[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(x0), lo[0]);
+    _mm_store_si128(reinterpret_cast<__m128i*>(x1), hi[0]);
+    _mm_store_si128(reinterpret_cast<__m128i*>(y0), lo[1]);
+    _mm_store_si128(reinterpret_cast<__m128i*>(y1), hi[1]);
+    _mm_store_si128(reinterpret_cast<__m128i*>(z0), lo[2]);
+    _mm_store_si128(reinterpret_cast<__m128i*>(z1), hi[2]);
+    const auto at = [&](const std::int32_t* z, const std::int32_t* y, const std::int32_t* x) {
+      return _mm_setr_ps(static_cast<float>(t[z[0] + y[0] + x[0]]), static_cast<float>(t[z[1] + y[1] + x[1]]),
+                         static_cast<float>(t[z[2] + y[2] + x[2]]), static_cast<float>(t[z[3] + y[3] + x[3]]));
+    };
+    const auto lerp = [](__m128 a, __m128 b, __m128 s) { return _mm_add_ps(a, _mm_mul_ps(s, _mm_sub_ps(b, a))); };
+    const __m128 a00 = lerp(at(z0, y0, x0), at(z0, y0, x1), f[0]);
+    const __m128 a10 = lerp(at(z0, y1, x0), at(z0, y1, x1), f[0]);
+    const __m128 a01 = lerp(at(z1, y0, x0), at(z1, y0, x1), f[0]);
+    const __m128 a11 = lerp(at(z1, y1, x0), at(z1, y1, x1), f[0]);
+    const __m128 r = _mm_mul_ps(lerp(lerp(a00, a10, f[1]), lerp(a01, a11, f[1]), f[2]), _mm_set1_ps(1.0f / 127.0f));
+    if (count - g >= 4) {
+      _mm_storeu_ps(out + g, r);
+    } else {
+      alignas(16) float tail[4];
+      _mm_store_ps(tail, r);
+      for (int k = 0; k < count - g; ++k) out[g + k] = tail[k];
+    }
+  }
+#else
+  for (int o = 0; o < count; ++o) {
+    const auto k = static_cast<std::size_t>(o);
+    out[o] = value(rotation_[k] * p + offset_[k]);
+  }
+#endif
 }
 
 float ValueLattice::fbm(const Eigen::Vector3f& p, int octaves, float gain, float footprint) const {
@@ -63,13 +111,19 @@ float ValueLattice::fbm(const Eigen::Vector3f& p, int octaves, float gain, float
   }
   // ratio = wavelength / footprint = 1 / (2^o footprint).
   float ratio = footprint > 0.0f ? 1.0f / footprint : 1e30f;
-  float sum = 0.0f, amp = 1.0f;
+  float scale[kMaxOctaves];  // weight_o · gain^o of the octaves kept
+  int count = 0;
+  float amp = 1.0f;
   for (int o = 0; o < octaves; ++o, ratio *= 0.5f, amp *= gain) {
     if (ratio <= 4.0f) break;
     const float weight = ratio < 8.0f ? (ratio - 4.0f) * 0.25f : 1.0f;
-    const auto k = static_cast<std::size_t>(o);
-    sum += weight * amp * value(rotation_[k] * p + offset_[k]);
+    scale[o] = weight * amp;
+    count = o + 1;
   }
+  float values[kMaxOctaves];
+  octaveValues(p, count, values);
+  float sum = 0.0f;
+  for (int o = 0; o < count; ++o) sum += scale[o] * values[o];
   return sum / norm;
 }
 

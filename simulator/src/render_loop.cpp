@@ -215,7 +215,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
       const CameraVelocity velocity = cameraVelocity(state, T_B_E);
       auto t0 = Clock::now();
       std::clock_t c0 = std::clock();
-      last = renderer.render(T_W_E, &velocity);
+      renderer.render(T_W_E, &velocity, &last);  // reuses last's images unless they are shared
       stats->render_s += secondsSince(t0);
       stats->render_cpu_s += cpuSecondsSince(c0);
       ++stats->renders;

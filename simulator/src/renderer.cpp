@@ -56,13 +56,25 @@ struct Renderer::Scratch {
 };
 
 RenderOutput Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderStats* stats) const {
+  RenderOutput out;
+  render(T_W_C, velocity, &out, stats);
+  return out;
+}
+
+void Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out_ptr,
+                      RenderStats* stats) const {
   if (options_.check_viewpoint) scene_.checkViewpoint(T_W_C.translation());
   const int w = camera_.width(), h = camera_.height();
-  RenderOutput out;
-  out.radiance.create(h, w, CV_32FC1);
-  out.depth.create(h, w, CV_32FC1);
-  out.normal.create(h, w, CV_32FC3);
-  if (velocity) out.flow.create(h, w, CV_32FC2);
+  RenderOutput& out = *out_ptr;
+  const auto prepare = [h, w](cv::Mat& m, int type) {
+    if (m.u != nullptr && m.u->refcount > 1) m.release();  // shared: do not overwrite the other's pixels
+    m.create(h, w, type);
+  };
+  prepare(out.radiance, CV_32FC1);
+  prepare(out.depth, CV_32FC1);
+  prepare(out.normal, CV_32FC3);
+  if (velocity) prepare(out.flow, CV_32FC2);
+  else out.flow.release();
   const int t = options_.tile_px;
   const int tiles = ((w + t - 1) / t) * ((h + t - 1) / t);
   std::vector<RenderStats> counts(static_cast<std::size_t>(tiles));
@@ -82,7 +94,6 @@ RenderOutput Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity,
       stats->shadow_rays += c.shadow_rays;
     }
   }
-  return out;
 }
 
 void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
@@ -107,9 +118,9 @@ void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* vel
   s.dirs.resize(rays);
   s.hits.resize(rays);
   s.albedo.resize(rays);
-  s.light.assign(rays * std::max<std::size_t>(lights, 1), scenes::LightSample{});
-  s.shadow.clear();
-  s.shadow_slot.clear();
+  s.light.resize(rays * std::max<std::size_t>(lights, 1));  // written below for every shaded ray
+  s.shadow.resize(rays * lights);
+  s.shadow_slot.resize(rays * lights);
 
   std::size_t ri = 0;
   for (int y = y0; y < y1; ++y)
@@ -133,6 +144,7 @@ void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* vel
 
   // Shading inputs and occlusion rays.
   const float footprint_scale = pixel_angle_rad_ / static_cast<float>(n);
+  std::size_t shadows = 0;
   for (ri = 0; ri < rays; ++ri) {
     const RTCRayHit& q = s.rays[ri];
     if (q.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
@@ -143,17 +155,20 @@ void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* vel
     s.albedo[ri] = scene_.albedo(hit, q.ray.tfar * footprint_scale / cos_view);
     for (std::size_t k = 0; k < lights; ++k) {
       scenes::ShadowRay sr;
-      if (!scene_.shadowRay(static_cast<int>(k), hit, &sr)) continue;
-      s.light[ri * lights + k] = scenes::LightSample{sr.direction, sr.e_normal};
-      s.shadow.emplace_back();
-      scenes::setRay(s.shadow.back(), sr.origin, sr.direction, 0.0f, sr.t_far);
-      s.shadow_slot.push_back(static_cast<std::uint32_t>(ri * lights + k));
+      scenes::LightSample& sample = s.light[ri * lights + k];
+      if (!scene_.shadowRay(static_cast<int>(k), hit, &sr)) {
+        sample = scenes::LightSample{};
+        continue;
+      }
+      sample = scenes::LightSample{sr.direction, sr.e_normal};
+      scenes::setRay(s.shadow[shadows], sr.origin, sr.direction, 0.0f, sr.t_far);
+      s.shadow_slot[shadows++] = static_cast<std::uint32_t>(ri * lights + k);
     }
   }
-  counts->shadow_rays = s.shadow.size();
-  if (!s.shadow.empty())
-    rtcOccluded1M(scene_.embree(), &coherent, s.shadow.data(), static_cast<unsigned>(s.shadow.size()), sizeof(RTCRay));
-  for (std::size_t i = 0; i < s.shadow.size(); ++i)
+  counts->shadow_rays = shadows;
+  if (shadows > 0)
+    rtcOccluded1M(scene_.embree(), &coherent, s.shadow.data(), static_cast<unsigned>(shadows), sizeof(RTCRay));
+  for (std::size_t i = 0; i < shadows; ++i)
     if (s.shadow[i].tfar < 0.0f) s.light[s.shadow_slot[i]].e_normal = 0.0f;  // occluded: tfar = -inf
 
   // Outputs.

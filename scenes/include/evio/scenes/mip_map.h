@@ -10,6 +10,9 @@
 /// level λ = log2(max(f, 1)) by bilinear interpolation between texel
 /// centres on levels ⌊λ⌋ and ⌊λ⌋ + 1 and blends them linearly.
 
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -30,9 +33,63 @@ class MipMap {
   const cv::Mat& level(int l) const { return levels_[static_cast<std::size_t>(l)]; }
 
  private:
+  /// One level as the lookup reads it (pointers into levels_, whose buffers
+  /// copies of the MipMap share).
+  struct Level {
+    const unsigned char* data = nullptr;
+    std::size_t step = 0;  ///< bytes per row
+    int cols = 0, rows = 0;
+    float fcols = 0.0f, frows = 0.0f;
+  };
   float bilinear(int level, float s, float t) const;
   std::vector<cv::Mat> levels_;
+  std::vector<Level> table_;
+  float fcols0_ = 0.0f, frows0_ = 0.0f;  ///< level-0 size as floats
   bool repeat_ = true;
 };
+
+// Lookups, inline for the renderer's inner loop.
+
+inline float MipMap::bilinear(int level, float s, float t) const {
+  const Level& m = table_[static_cast<std::size_t>(level)];
+  // Level-0 coordinates to this level's, texel centres at integers.
+  const float x = s * m.fcols / fcols0_ - 0.5f;
+  const float y = t * m.frows / frows0_ - 0.5f;
+  const float fx0 = std::floor(x), fy0 = std::floor(y);
+  const float fx = x - fx0, fy = y - fy0;
+  int x0 = static_cast<int>(fx0), y0 = static_cast<int>(fy0);
+  int x1 = x0 + 1, y1 = y0 + 1;
+  if (repeat_) {
+    const auto wrap = [](int i, int n) {
+      i %= n;
+      return i < 0 ? i + n : i;
+    };
+    x0 = wrap(x0, m.cols);
+    x1 = wrap(x1, m.cols);
+    y0 = wrap(y0, m.rows);
+    y1 = wrap(y1, m.rows);
+  } else {
+    x0 = std::clamp(x0, 0, m.cols - 1);
+    x1 = std::clamp(x1, 0, m.cols - 1);
+    y0 = std::clamp(y0, 0, m.rows - 1);
+    y1 = std::clamp(y1, 0, m.rows - 1);
+  }
+  const auto* r0 = reinterpret_cast<const float*>(m.data + static_cast<std::size_t>(y0) * m.step);
+  const auto* r1 = reinterpret_cast<const float*>(m.data + static_cast<std::size_t>(y1) * m.step);
+  const float a = r0[x0] + fx * (r0[x1] - r0[x0]);
+  const float b = r1[x0] + fx * (r1[x1] - r1[x0]);
+  return a + fy * (b - a);
+}
+
+inline float MipMap::sample(float s, float t, float footprint) const {
+  if (!(footprint > 1.0f)) return bilinear(0, s, t);
+  const float lambda = std::log2(footprint);
+  const int top = levels() - 1;
+  const int l0 = std::min(static_cast<int>(lambda), top);
+  if (l0 >= top) return bilinear(top, s, t);
+  const float f = lambda - static_cast<float>(l0);
+  const float a = bilinear(l0, s, t);
+  return a + f * (bilinear(l0 + 1, s, t) - a);
+}
 
 }  // namespace evio::scenes

@@ -17,7 +17,11 @@
 
 #include <embree3/rtcore.h>
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -52,7 +56,7 @@ struct SceneMesh {
 /// Timings (wall clock, s) and sizes of the build.
 struct SceneStats {
   double generate_s = 0.0;   ///< procedural generation and file import
-  double bvh_s = 0.0;        ///< Embree BVH build
+  double bvh_s = 0.0;        ///< Embree BVH build and the interleaved shading copy of the meshes
   double indirect_s = 0.0;   ///< irradiance cache
   std::size_t triangles = 0;
   std::size_t vertices = 0;
@@ -167,12 +171,29 @@ class Scene {
     Reflectance reflectance;
     std::unique_ptr<Texture> texture;
   };
+  /// The data surfaceHit reads, interleaved so that a hit touches one
+  /// cache line per vertex and one per triangle (a copy of meshes_).
+  struct alignas(32) ShadeVertex {
+    Eigen::Vector3f p;   ///< position (m)
+    Eigen::Vector3f n;   ///< unit vertex normal
+    Eigen::Vector2f uv;  ///< surface coordinates (m)
+  };
+  struct ShadeTriangle {
+    std::uint32_t v[3];  ///< vertex indices
+    Eigen::Vector3f ng;  ///< unit face normal (0 for a degenerate triangle)
+  };
+  struct ShadeMesh {
+    std::vector<ShadeVertex> vertices;
+    std::vector<ShadeTriangle> triangles;
+  };
   void generate(const SceneBuildOptions& options);
   void buildEmbree(const SceneBuildOptions& options);
+  void buildShadeMeshes();
   void lightFrom(const SurfaceHit& hit, int k, Eigen::Vector3f* wi, float* e_normal) const;
 
   SceneDescription description_;
   std::vector<SceneMesh> meshes_;
+  std::vector<ShadeMesh> shade_;  ///< shade_[g] mirrors meshes_[g]
   std::vector<MaterialData> materials_;
   std::vector<DirectLight> direct_;
   float sky_radiance_ = 0.0f;
@@ -182,5 +203,110 @@ class Scene {
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
 };
+
+// The per-pixel functions, inline for the renderer's inner loop.
+
+inline void Scene::surfaceHit(unsigned geom, unsigned prim, float u, float v, const Eigen::Vector3f& dir,
+                              SurfaceHit* hit) const {
+  const ShadeMesh& sm = shade_[geom];
+  const ShadeTriangle& t = sm.triangles[prim];
+  const ShadeVertex& a = sm.vertices[t.v[0]];
+  const ShadeVertex& b = sm.vertices[t.v[1]];
+  const ShadeVertex& c = sm.vertices[t.v[2]];
+  const float w0 = 1.0f - u - v;
+  SurfaceHit& h = *hit;
+  h.mesh = geom;
+  h.prim = prim;
+  h.b1 = u;
+  h.b2 = v;
+  h.p = w0 * a.p + u * b.p + v * c.p;
+  Eigen::Vector3f ng = t.ng;
+  if (ng.x() == 0.0f && ng.y() == 0.0f && ng.z() == 0.0f) ng = -dir;  // degenerate triangle
+  Eigen::Vector3f n = w0 * a.n + u * b.n + v * c.n;
+  const float nlen2 = n.squaredNorm();
+  n = nlen2 > 0.0f ? Eigen::Vector3f(n * (1.0f / std::sqrt(nlen2))) : ng;
+  h.back_face = ng.dot(dir) > 0.0f;
+  if (h.back_face) {
+    ng = -ng;
+    n = -n;
+  }
+  if (n.dot(dir) >= 0.0f) n = ng;  // a shading normal facing away from the viewer
+  h.n = n;
+  h.ng = ng;
+  h.uv = w0 * a.uv + u * b.uv + v * c.uv;
+}
+
+inline float Scene::albedo(const SurfaceHit& hit, float footprint_m) const {
+  const auto& mat = materials_[static_cast<std::size_t>(meshes_[hit.mesh].material)];
+  return mat.texture->evaluate(hit.p, hit.uv, footprint_m);
+}
+
+inline void Scene::lightFrom(const SurfaceHit& hit, int k, Eigen::Vector3f* wi, float* e_normal) const {
+  const DirectLight& d = direct_[static_cast<std::size_t>(k)];
+  if (d.kind == 0) {
+    *wi = d.vec;
+    *e_normal = d.power;
+    return;
+  }
+  const Eigen::Vector3f to = d.vec - hit.p;
+  const float d2 = to.squaredNorm();
+  if (!(d2 > 0.0f)) {
+    *e_normal = 0.0f;
+    *wi = hit.n;
+    return;
+  }
+  *wi = to / std::sqrt(d2);
+  float e = d.power / d2;
+  if (d.kind == 2) {
+    const float c = -wi->dot(d.axis);
+    float t = (c - d.cos_outer) / (d.cos_inner - d.cos_outer);
+    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+    e *= t * t * (3.0f - 2.0f * t);
+  }
+  *e_normal = e;
+}
+
+inline bool Scene::shadowRay(int k, const SurfaceHit& hit, ShadowRay* ray) const {
+  Eigen::Vector3f wi;
+  float e = 0.0f;
+  lightFrom(hit, k, &wi, &e);
+  if (!(e > 0.0f) || hit.ng.dot(wi) <= 0.0f || hit.n.dot(wi) <= 0.0f) return false;
+  const float eps = 5e-5f * (1.0f + hit.p.cwiseAbs().maxCoeff());
+  ray->origin = hit.p + eps * hit.ng;
+  ray->direction = wi;
+  ray->e_normal = e;
+  const DirectLight& d = direct_[static_cast<std::size_t>(k)];
+  ray->t_far = d.kind == 0 ? std::numeric_limits<float>::infinity()
+                           : (d.vec - ray->origin).norm() * (1.0f - 1e-5f);
+  return true;
+}
+
+inline float Scene::radiance(const SurfaceHit& hit, const Eigen::Vector3f& to_viewer, float albedo,
+                      const LightSample* lights) const {
+  const Reflectance& refl = materials_[static_cast<std::size_t>(meshes_[hit.mesh].material)].reflectance;
+  const float c_o = hit.n.dot(to_viewer);
+  float l = 0.0f;
+  for (int k = 0; k < static_cast<int>(direct_.size()); ++k) {
+    const LightSample& s = lights[k];
+    if (!(s.e_normal > 0.0f)) continue;
+    const float c_i = hit.n.dot(s.wi);
+    if (c_i <= 0.0f) continue;
+    l += refl.brdfOverAlbedo(s.wi, to_viewer, c_i, c_o) * s.e_normal * c_i;
+  }
+  float e_amb;
+  if (indirect_on_) e_amb = interpolate(hit, indirect_);
+  else e_amb = std::numbers::pi_v<float> * sky_radiance_ * 0.5f * (1.0f + hit.n.z());
+  return albedo * (l + e_amb * (1.0f / std::numbers::pi_v<float>));
+}
+
+inline float Scene::background(const Eigen::Vector3f& dir) const { return dir.z() > 0.0f ? sky_radiance_ : 0.0f; }
+
+inline float Scene::interpolate(const SurfaceHit& hit, const std::vector<std::vector<float>>& cache) const {
+  if (cache.empty()) return 0.0f;
+  const auto& values = cache[hit.mesh];
+  if (values.empty()) return 0.0f;
+  const std::uint32_t* t = shade_[hit.mesh].triangles[hit.prim].v;
+  return (1.0f - hit.b1 - hit.b2) * values[t[0]] + hit.b1 * values[t[1]] + hit.b2 * values[t[2]];
+}
 
 }  // namespace evio::scenes

@@ -35,10 +35,56 @@ class ValueLattice {
   /// Multi-octave value noise (see the file comment); about [−1, 1].
   float fbm(const Eigen::Vector3f& p, int octaves, float gain, float footprint = 0.0f) const;
 
+  /// Octave o alone, n(R_o 2^o p + t_o), through the scalar value(): the
+  /// reference for fbm's terms, which are evaluated four at a time.
+  float octave(const Eigen::Vector3f& p, int o) const {
+    const auto k = static_cast<std::size_t>(o);
+    return value(rotation_[k] * p + offset_[k]);
+  }
+
  private:
+  /// n(R_o 2^o p + t_o) for octaves [0, count) into out[0, count), four
+  /// octaves at a time with SSE2 (the scalar value() otherwise); the same
+  /// float operations in the same order as value(), so bit-identical to it.
+  void octaveValues(const Eigen::Vector3f& p, int count, float* out) const;
+
   std::vector<std::int8_t> v_;  ///< kSize³ values × 127, x fastest (256 KiB: stays in cache)
   std::array<Eigen::Matrix3f, kMaxOctaves> rotation_;  ///< 2^o R_o
   std::array<Eigen::Vector3f, kMaxOctaves> offset_;
+  /// The same, one row per matrix entry (3 i + j) or offset component,
+  /// one column per octave (for octaveValues).
+  alignas(16) std::array<std::array<float, kMaxOctaves>, 9> rotation_soa_{};
+  alignas(16) std::array<std::array<float, kMaxOctaves>, 3> offset_soa_{};
 };
+
+namespace detail {
+inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+inline int floorInt(float x) {
+  const int i = static_cast<int>(x);
+  return (x < static_cast<float>(i)) ? i - 1 : i;
+}
+}  // namespace detail
+
+// The lookup, inline for the texture's inner loop.
+
+inline float ValueLattice::value(const Eigen::Vector3f& p) const {
+  const int ix = detail::floorInt(p.x()), iy = detail::floorInt(p.y()), iz = detail::floorInt(p.z());
+  const float u = detail::fade(p.x() - static_cast<float>(ix));
+  const float v = detail::fade(p.y() - static_cast<float>(iy));
+  const float w = detail::fade(p.z() - static_cast<float>(iz));
+  constexpr int m = kSize - 1;
+  const int x0 = ix & m, x1 = (ix + 1) & m;
+  const int y0 = (iy & m) * kSize, y1 = ((iy + 1) & m) * kSize;
+  const int z0 = (iz & m) * kSize * kSize, z1 = ((iz + 1) & m) * kSize * kSize;
+  const std::int8_t* t = v_.data();
+  const auto at = [t](int i) { return static_cast<float>(t[i]); };
+  const float a00 = at(z0 + y0 + x0) + u * (at(z0 + y0 + x1) - at(z0 + y0 + x0));
+  const float a10 = at(z0 + y1 + x0) + u * (at(z0 + y1 + x1) - at(z0 + y1 + x0));
+  const float a01 = at(z1 + y0 + x0) + u * (at(z1 + y0 + x1) - at(z1 + y0 + x0));
+  const float a11 = at(z1 + y1 + x0) + u * (at(z1 + y1 + x1) - at(z1 + y1 + x0));
+  const float b0 = a00 + v * (a10 - a00);
+  const float b1 = a01 + v * (a11 - a01);
+  return (b0 + w * (b1 - b0)) * (1.0f / 127.0f);
+}
 
 }  // namespace evio::noise

@@ -75,6 +75,13 @@ class Renderer {
   RenderOutput render(const Pose& T_W_C, const CameraVelocity* velocity = nullptr,
                       RenderStats* stats = nullptr) const;
 
+  /// The same, into *out: its images are reused when they already have the
+  /// right size and type and are not shared with another cv::Mat (else
+  /// reallocated), which saves the page faults of fresh images per render.
+  /// out->flow is released without a velocity.
+  void render(const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
+              RenderStats* stats = nullptr) const;
+
   /// Unit bearing in C of the centre ray of pixel (x, y); NaN when the model
   /// cannot unproject that pixel.
   Eigen::Vector3f bearing(int x, int y) const {

@@ -1,5 +1,6 @@
 #include "evio/scenes/value_noise.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -36,12 +37,13 @@ ValueLattice::ValueLattice(std::uint64_t seed) : v_(static_cast<std::size_t>(kSi
     }
 }
 
-void ValueLattice::octaveValues(const Eigen::Vector3f& p, int count, float* out) const {
+void ValueLattice::octaveValues(const Eigen::Vector3f& p, int first, int count, float* out) const {
 #if defined(__SSE2__)
   const __m128 px = _mm_set1_ps(p.x()), py = _mm_set1_ps(p.y()), pz = _mm_set1_ps(p.z());
   const __m128i m = _mm_set1_epi32(kSize - 1), one = _mm_set1_epi32(1);
   const std::int8_t* t = v_.data();
-  for (int g = 0; g < count; g += 4) {
+  {
+    const int g = first;
     const auto row = [g](const std::array<float, kMaxOctaves>& r) { return _mm_load_ps(r.data() + g); };
     __m128 q[3];
     for (int i = 0; i < 3; ++i)  // (R p)_i + t_i, summed in Eigen's order: (r_i0 x + (r_i1 y + r_i2 z)) + t_i
@@ -77,8 +79,8 @@ void ValueLattice::octaveValues(const Eigen::Vector3f& p, int count, float* out)
     _mm_store_si128(reinterpret_cast<__m128i*>(z0), lo[2]);
     _mm_store_si128(reinterpret_cast<__m128i*>(z1), hi[2]);
     const auto at = [&](const std::int32_t* z, const std::int32_t* y, const std::int32_t* x) {
-      return _mm_setr_ps(static_cast<float>(t[z[0] + y[0] + x[0]]), static_cast<float>(t[z[1] + y[1] + x[1]]),
-                         static_cast<float>(t[z[2] + y[2] + x[2]]), static_cast<float>(t[z[3] + y[3] + x[3]]));
+      return _mm_cvtepi32_ps(_mm_setr_epi32(t[z[0] + y[0] + x[0]], t[z[1] + y[1] + x[1]], t[z[2] + y[2] + x[2]],
+                                            t[z[3] + y[3] + x[3]]));
     };
     const auto lerp = [](__m128 a, __m128 b, __m128 s) { return _mm_add_ps(a, _mm_mul_ps(s, _mm_sub_ps(b, a))); };
     const __m128 a00 = lerp(at(z0, y0, x0), at(z0, y0, x1), f[0]);
@@ -86,19 +88,16 @@ void ValueLattice::octaveValues(const Eigen::Vector3f& p, int count, float* out)
     const __m128 a01 = lerp(at(z1, y0, x0), at(z1, y0, x1), f[0]);
     const __m128 a11 = lerp(at(z1, y1, x0), at(z1, y1, x1), f[0]);
     const __m128 r = _mm_mul_ps(lerp(lerp(a00, a10, f[1]), lerp(a01, a11, f[1]), f[2]), _mm_set1_ps(1.0f / 127.0f));
-    if (count - g >= 4) {
-      _mm_storeu_ps(out + g, r);
+    if (count >= 4) {
+      _mm_storeu_ps(out, r);
     } else {
       alignas(16) float tail[4];
       _mm_store_ps(tail, r);
-      for (int k = 0; k < count - g; ++k) out[g + k] = tail[k];
+      for (int k = 0; k < count; ++k) out[k] = tail[k];
     }
   }
 #else
-  for (int o = 0; o < count; ++o) {
-    const auto k = static_cast<std::size_t>(o);
-    out[o] = value(rotation_[k] * p + offset_[k]);
-  }
+  for (int k = 0; k < count; ++k) out[k] = octave(p, first + k);
 #endif
 }
 
@@ -120,10 +119,14 @@ float ValueLattice::fbm(const Eigen::Vector3f& p, int octaves, float gain, float
     scale[o] = weight * amp;
     count = o + 1;
   }
+  // Groups of three or four octaves side by side; one or two alone (a group
+  // costs about as much as two single octaves).
   float values[kMaxOctaves];
-  octaveValues(p, count, values);
+  int o = 0;
+  for (; count - o >= 3; o += 4) octaveValues(p, o, std::min(4, count - o), values + o);
+  for (; o < count; ++o) values[o] = octave(p, o);
   float sum = 0.0f;
-  for (int o = 0; o < count; ++o) sum += scale[o] * values[o];
+  for (int k = 0; k < count; ++k) sum += scale[k] * values[k];
   return sum / norm;
 }
 

@@ -43,10 +43,11 @@ class ValueLattice {
   }
 
  private:
-  /// n(R_o 2^o p + t_o) for octaves [0, count) into out[0, count), four
-  /// octaves at a time with SSE2 (the scalar value() otherwise); the same
-  /// float operations in the same order as value(), so bit-identical to it.
-  void octaveValues(const Eigen::Vector3f& p, int count, float* out) const;
+  /// n(R_o 2^o p + t_o) for the count ≤ 4 octaves o = first, first + 1, ...
+  /// into out[0, count), side by side with SSE2 (octave() otherwise); the
+  /// same float operations in the same order as octave(), so bit-identical
+  /// to it at the project's flags.
+  void octaveValues(const Eigen::Vector3f& p, int first, int count, float* out) const;
 
   std::vector<std::int8_t> v_;  ///< kSize³ values × 127, x fastest (256 KiB: stays in cache)
   std::array<Eigen::Matrix3f, kMaxOctaves> rotation_;  ///< 2^o R_o

@@ -145,7 +145,18 @@ void Renderer::renderTile(int tile, const Pose& T_W_C, const CameraVelocity* vel
   // Shading inputs and occlusion rays.
   const float footprint_scale = pixel_angle_rad_ / static_cast<float>(n);
   std::size_t shadows = 0;
+  // The shading data of large meshes is mostly not in cache: fetch the
+  // triangle record kAhead hits ahead and its vertices kAhead / 2 ahead.
+  constexpr std::size_t kAhead = 8;
+  const auto prefetch = [&](std::size_t r, int stage) {
+    if (r < rays && s.rays[r].hit.geomID != RTC_INVALID_GEOMETRY_ID)
+      scene_.prefetchHit(s.rays[r].hit.geomID, s.rays[r].hit.primID, stage);
+  };
+  for (std::size_t r = 0; r < kAhead; ++r) prefetch(r, 0);
+  for (std::size_t r = 0; r < kAhead / 2; ++r) prefetch(r, 1);
   for (ri = 0; ri < rays; ++ri) {
+    prefetch(ri + kAhead, 0);
+    prefetch(ri + kAhead / 2, 1);
     const RTCRayHit& q = s.rays[ri];
     if (q.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
     scenes::SurfaceHit& hit = s.hits[ri];

@@ -124,6 +124,12 @@ class Scene {
   void surfaceHit(unsigned geom, unsigned prim, float u, float v, const Eigen::Vector3f& dir,
                   SurfaceHit* hit) const;
 
+  /// Cache hints for a later surfaceHit(geom, prim, ...) on a large mesh:
+  /// stage 0 fetches the triangle's record, stage 1 (issued some hits after
+  /// stage 0, when the record has arrived) its three vertices. No effect on
+  /// results.
+  void prefetchHit(unsigned geom, unsigned prim, int stage) const;
+
   /// Albedo ρ at a hit; footprint_m is the pixel size on the surface (m).
   float albedo(const SurfaceHit& hit, float footprint_m) const;
 
@@ -234,6 +240,22 @@ inline void Scene::surfaceHit(unsigned geom, unsigned prim, float u, float v, co
   h.n = n;
   h.ng = ng;
   h.uv = w0 * a.uv + u * b.uv + v * c.uv;
+}
+
+inline void Scene::prefetchHit(unsigned geom, unsigned prim, int stage) const {
+#if defined(__GNUC__)
+  const ShadeMesh& sm = shade_[geom];
+  const ShadeTriangle& t = sm.triangles[prim];
+  if (stage == 0) {
+    __builtin_prefetch(&t);
+  } else {
+    __builtin_prefetch(&sm.vertices[t.v[0]]);
+    __builtin_prefetch(&sm.vertices[t.v[1]]);
+    __builtin_prefetch(&sm.vertices[t.v[2]]);
+  }
+#else
+  (void)geom, (void)prim, (void)stage;
+#endif
 }
 
 inline float Scene::albedo(const SurfaceHit& hit, float footprint_m) const {

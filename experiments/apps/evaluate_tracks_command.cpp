@@ -6,10 +6,14 @@
 // tracks (a tracks.txt file, or a sequence folder holding truth/tracks.txt).
 // JSON holds the summary and both tables; CSV writes error vs age to the file
 // and the alive count to <stem>_alive.csv.
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "commands.h"
 #include "evio/core/error.h"
@@ -50,6 +54,7 @@ void addEvaluateTracksCommand(CLI::App& app) {
     experiments::DepthTruthOptions depth;
     std::string mode = "auto";
     std::string camera;
+    std::string truth_output;
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
@@ -64,6 +69,8 @@ void addEvaluateTracksCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "depth", "tracks"}));
   cmd->add_option("--camera", args->camera,
                   "depth: camera of the track pixels (default: from the tracks file header, else the event camera)");
+  cmd->add_option("--truth-output", args->truth_output,
+                  "depth: also write each track's true positions (id t x y, until its truth ends)");
   cmd->add_option("--depth-time-tolerance", args->depth.max_depth_time_offset_s,
                   "depth: largest offset of a track's first sample from a depth-map stamp, s");
   cmd->add_option("--max-depth-curvature", args->depth.max_depth_curvature,
@@ -89,6 +96,18 @@ void addEvaluateTracksCommand(CLI::App& app) {
       const std::string camera = args->camera.empty() ? trackCamera(args->tracks) : args->camera;
       const auto truth = experiments::loadDepthTrackTruth(args->truth, camera, args->depth);
       metrics = experiments::evaluateTracks(estimated, truth, args->options);
+      if (!args->truth_output.empty()) {
+        std::map<std::int64_t, std::vector<io::TrackSample>> by_id;
+        for (const auto& s : estimated) by_id[s.id].push_back(s);
+        std::vector<io::TrackSample> out;
+        for (auto& [id, track] : by_id) {
+          std::stable_sort(track.begin(), track.end(), [](const auto& a, const auto& b) { return a.t_ns < b.t_ns; });
+          const auto tt = truth.truthOf(track);
+          for (std::size_t k = 0; k < tt.uv.size(); ++k) out.push_back({id, track[k].t_ns, tt.uv[k]});
+        }
+        io::writeTracksText(args->truth_output, out,
+                            {"evio evaluate-tracks: true positions of the tracks of " + args->tracks, "id t x y"});
+      }
     } else {
       const std::string truth_file = folder ? (fs::path(args->truth) / "truth" / "tracks.txt").string() : args->truth;
       metrics = experiments::evaluateTracks(estimated, io::readTracksText(truth_file), args->options);

@@ -4,7 +4,8 @@
 # camera over- and under-exposed), runs EKLT on frames, EKLT on reconstructed
 # images and KLT (`evio track`), scores every track against the truth from
 # the depth maps and poses (`evio evaluate-tracks`, depth mode) and prints a
-# markdown table.
+# markdown table; a second table scores the same tracks with a 1 px error
+# bound (how long they stay sub-pixel), a third gives the frames' motion blur.
 #
 #   experiments/scripts/tracking_table.sh [--evio build/release/bin/evio] [--out out/tracking]
 #                                         [--depth-time-tolerance 0.03] [--only NAME]
@@ -18,6 +19,18 @@
 #                          about 30x in the sunlit sand: sunlit half blown out)
 #   underexposed: 2e-5 s  (about 1/27 of the shadow's auto-exposure: the
 #                          shadow is 0-5 DN, the sunlit sand about 40 DN)
+#
+# Fast rows (*_fast): the 6-DOF one-minute speed ramp compressed into 12 s
+# (trajectory.duration_s=12, as experiments/campaigns/paper_table.yaml),
+# simulated only from 6 s to 12 s (the faster half: image speed median about
+# 500 px/s, 90 % about 900 px/s) to save time; frame camera as configured
+# (auto-exposure picks 0.1-0.2 ms: blur below 0.4 px).
+# *_fast_long: fixed 15 ms exposure with the lens stopped down from f/4 to
+# f/32 (poster, 1/64 of the light) or f/45 (shapes, 1/127), the same photon
+# count as a 64x / 127x dimmer room (mean 150 / 114 DN, 3 % / 0 % at 255),
+# and 16 renders per exposure instead of 3 so the 7-21 px blur is rendered in
+# steps of at most 1.4 px. The extra renders also update the event camera,
+# so its events differ slightly from *_fast.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 EVIO=build/release/bin/evio
@@ -36,14 +49,20 @@ done
 [ -x "$EVIO" ] || { echo "no evio binary at $EVIO (--evio)" >&2; exit 2; }
 mkdir -p "$OUT"
 FIXED="--set rig.frame_camera.sensor.auto_exposure=false --set rig.frame_camera.meter_first_exposure=false"
+FAST="--set trajectory.duration_s=12 --set start_s=6 --set duration_s=6 --set output.write_events_txt=false"
 declare -A SIM=(
   [poster_6dof]="experiments/scenarios/poster_6dof.yaml --set duration_s=10"
   [shapes_6dof]="experiments/scenarios/shapes_6dof.yaml --set duration_s=10"
   [mars_yard_circle]="experiments/scenarios/mars_yard_circle.yaml --set duration_s=10 --set trajectory.duration_s=10"
   [mars_yard_circle_overexposed]="experiments/scenarios/mars_yard_circle.yaml --set duration_s=10 --set trajectory.duration_s=10 $FIXED --set rig.frame_camera.sensor.exposure_s=1e-3 --set output.write_events_txt=false"
   [mars_yard_circle_underexposed]="experiments/scenarios/mars_yard_circle.yaml --set duration_s=10 --set trajectory.duration_s=10 $FIXED --set rig.frame_camera.sensor.exposure_s=2e-5 --set output.write_events_txt=false"
+  [poster_6dof_fast]="experiments/scenarios/poster_6dof.yaml $FAST"
+  [poster_6dof_fast_long]="experiments/scenarios/poster_6dof.yaml $FAST $FIXED --set rig.frame_camera.sensor.exposure_s=0.015 --set rig.frame_camera.sensor.f_number=32 --set rig.frame_camera.exposure_samples=16"
+  [shapes_6dof_fast]="experiments/scenarios/shapes_6dof.yaml $FAST"
+  [shapes_6dof_fast_long]="experiments/scenarios/shapes_6dof.yaml $FAST $FIXED --set rig.frame_camera.sensor.exposure_s=0.015 --set rig.frame_camera.sensor.f_number=45 --set rig.frame_camera.exposure_samples=16"
 )
-SEQS="poster_6dof shapes_6dof mars_yard_circle mars_yard_circle_overexposed mars_yard_circle_underexposed"
+SEQS="poster_6dof shapes_6dof mars_yard_circle mars_yard_circle_overexposed mars_yard_circle_underexposed
+      poster_6dof_fast poster_6dof_fast_long shapes_6dof_fast shapes_6dof_fast_long"
 METHODS="eklt_frames eklt_reconstructed klt"
 for s in $SEQS; do
   [ -n "$ONLY" ] && [ "$ONLY" != "$s" ] && continue
@@ -67,6 +86,9 @@ for s in $SEQS; do
     fi
     "$EVIO" evaluate-tracks "$tracks" "$seq" --mode depth --depth-time-tolerance "$TOL" \
       -o "$OUT/${s}_$m.json" -q
+    # the same with a 1 px error bound: how long tracks stay sub-pixel
+    "$EVIO" evaluate-tracks "$tracks" "$seq" --mode depth --depth-time-tolerance "$TOL" \
+      --max-error 1 -o "$OUT/${s}_${m}_1px.json" -q
   done
 done
 
@@ -92,4 +114,61 @@ for s in seqs:
             s, names[k], m["estimated_tracks"], m["matched_tracks"], m["mean_error_px"], m["median_error_px"],
             m["mean_feature_age_s"], m["median_feature_age_s"], m["ended_by_error"], m["ended_by_truth"],
             m["ended_by_track"], at_age(m, 0.1), at_age(m, 0.5), at_age(m, 1.0)))
+print()
+print("| sequence | tracker | sub-pixel age (until error > 1 px) mean / median (s) | ended by error / truth / track |")
+print("|---|---|---|---|")
+for s in seqs:
+    for k in methods:
+        p = os.path.join(out, "%s_%s_1px.json" % (s, k))
+        if not os.path.exists(p):
+            continue
+        m = json.load(open(p))
+        print("| %s | %s | %.3f / %.3f | %d / %d / %d |" % (
+            s, names[k], m["mean_feature_age_s"], m["median_feature_age_s"], m["ended_by_error"],
+            m["ended_by_truth"], m["ended_by_track"]))
+PY
+
+# Motion blur of the frames: exposure of frame k = 2 (stamp_k − start − k / rate)
+# (stamps are mid-exposure), image speed from truth/tracks.txt (ground-truth
+# point tracks, central differences at 200 Hz) at the track samples nearest
+# each frame stamp, blur length = speed × exposure.
+python3 - "$OUT" "$SEQS" <<'PY'
+import bisect, math, os, sys, yaml
+from collections import defaultdict
+out, seqs = sys.argv[1], sys.argv[2].split()
+def q(v, p):
+    v = sorted(v)
+    return v[min(len(v) - 1, int(p * len(v)))] if v else float("nan")
+print()
+print("| sequence | exposure median (ms) | image speed at frame stamps median / p90 / max (px/s) "
+      "| blur length median / p90 / max (px) |")
+print("|---|---|---|---|")
+for s in seqs:
+    d = os.path.join(out, s)
+    if not os.path.exists(os.path.join(d, "truth", "tracks.txt")):
+        continue
+    sc = yaml.safe_load(open(os.path.join(d, "scenario.yaml")))
+    start, rate = float(sc["start_s"]), float(sc["rig"]["frame_camera"]["rate_hz"])
+    frames = [float(l.split()[0]) for l in open(os.path.join(d, "images.txt")) if l.strip() and l[0] != "#"]
+    exposure = [2.0 * (t - start - k / rate) for k, t in enumerate(frames)]
+    tracks = defaultdict(list)
+    for l in open(os.path.join(d, "truth", "tracks.txt")):
+        if l[0] == "#":
+            continue
+        i, t, x, y = l.split()
+        tracks[i].append((float(t), float(x), float(y)))
+    speed = defaultdict(list)  # frame index -> speeds
+    for samples in tracks.values():
+        ts = [p[0] for p in samples]
+        for k, tf in enumerate(frames):
+            j = bisect.bisect_left(ts, tf)
+            for c in (j - 1, j):
+                if 1 <= c < len(samples) - 1 and abs(ts[c] - tf) <= 0.0026 and ts[c + 1] - ts[c - 1] < 0.011:
+                    a, b = samples[c - 1], samples[c + 1]
+                    speed[k].append(math.hypot(b[1] - a[1], b[2] - a[2]) / (b[0] - a[0]))
+                    break
+    sp = [v for k in speed for v in speed[k]]
+    blur = [v * exposure[k] for k in speed for v in speed[k]]
+    print("| %s | %.3f | %.0f / %.0f / %.0f | %.2f / %.2f / %.2f |" % (
+        s, 1e3 * q(exposure, 0.5), q(sp, 0.5), q(sp, 0.9), max(sp), q(blur, 0.5), q(blur, 0.9), max(blur)))
 PY

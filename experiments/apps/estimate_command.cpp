@@ -74,9 +74,11 @@ void addEstimateCommand(CLI::App& app) {
         throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|tracks or method: in " +
                     (args->config.empty() ? std::string("--set") : args->config));
       args->method = config::detail::scalarAs<std::string>(doc, m, "method");
-      if (args->method != "eklt-vio" && args->method != "klt-vio" && args->method != "tracks")
-        throw Error(config::where(doc, m, "method") + ": must be eklt-vio, klt-vio or tracks (got '" +
-                    args->method + "')");
+      try {
+        (void)estimator::PipelineOptions::forMethod(args->method);  // the one list of methods
+      } catch (const Error& e) {
+        throw Error(config::where(doc, m, "method") + ": " + e.what());
+      }
     }
     config::applyOverride(doc, "method=" + args->method);
     if (!args->tracks.empty()) config::applyOverride(doc, "tracks.file=" + args->tracks);

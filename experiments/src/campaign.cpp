@@ -282,11 +282,14 @@ std::vector<Job> expandJobs(const Campaign& c) {
       }
     combos = std::move(next);
   }
+  // Seed-major: a campaign stopped part-way has whole seeds (every cell with
+  // the same number of runs); within a seed, neighbouring jobs run different
+  // scenarios, so that parallel workers simulate different sequences.
   std::vector<Job> jobs;
-  for (std::size_t m = 0; m < c.methods.size(); ++m) {
-    for (const auto& combo : combos) {
-      for (std::size_t s = 0; s < c.scenarios.size(); ++s) {
-        for (const std::uint64_t seed : c.seeds) {
+  for (const std::uint64_t seed : c.seeds) {
+    for (std::size_t m = 0; m < c.methods.size(); ++m) {
+      for (const auto& combo : combos) {
+        for (std::size_t s = 0; s < c.scenarios.size(); ++s) {
           Job j;
           j.scenario = s;
           j.method = m;

@@ -74,7 +74,10 @@ TEST(Campaign, ExpandsTheMatrixWithStableUniqueIds) {
   }
   EXPECT_EQ(ids.size(), jobs.size());
   EXPECT_EQ(sequences.size(), 6u);  // the sweep and the method do not touch the sequence
-  // Variant-major order: the first jobs need different sequences.
+  // Seed-major order: the first 2 × 2 × 2 jobs are every cell of seed 1, so a
+  // stopped campaign has whole seeds; neighbouring jobs need different sequences.
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(jobs[i].seed, 1u) << i;
+  EXPECT_EQ(jobs[8].seed, 2u);
   EXPECT_NE(jobs[0].sequence_key, jobs[1].sequence_key);
   // The id is a readable prefix and a hash of everything that defines the job.
   EXPECT_EQ(jobs[0].id.rfind("a.good.s1.", 0), 0u);

@@ -125,9 +125,11 @@ struct Job {
   std::string sequence_key; ///< cache path "<scenario>.<hash8>/seed-<seed>" ("" for recorded sequences)
 };
 
-/// The jobs of a campaign, ordered so that consecutive jobs need different
-/// sequences (variant — method and sweep — outermost, then scenario, seed),
-/// which lets parallel workers simulate different sequences at once. The id
+/// The jobs of a campaign, seed outermost (a campaign stopped part-way holds
+/// whole seeds: every cell has the same number of runs), then the variant
+/// (method, sweep values), then the scenario innermost, so that with several
+/// scenarios neighbouring jobs need different sequences and parallel workers
+/// simulate different sequences at once. The id
 /// hashes scenario, method, seed and every override, so a changed
 /// configuration makes new jobs instead of reusing stale results.
 std::vector<Job> expandJobs(const Campaign& campaign);

@@ -59,7 +59,9 @@ inline float MipMap::bilinear(int level, float s, float t) const {
   const float fx = x - fx0, fy = y - fy0;
   int x0 = static_cast<int>(fx0), y0 = static_cast<int>(fy0);
   int x1 = x0 + 1, y1 = y0 + 1;
-  if (repeat_) {
+  if (x0 >= 0 && x1 < m.cols && y0 >= 0 && y1 < m.rows) {
+    // Inside the level (the common case): no wrapping or clamping.
+  } else if (repeat_) {
     const auto wrap = [](int i, int n) {
       i %= n;
       return i < 0 ? i + n : i;

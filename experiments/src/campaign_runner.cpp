@@ -3,6 +3,7 @@
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
@@ -197,6 +198,42 @@ std::string ensureSequence(const Campaign& c, const Job& job, const RunnerOption
   return "";
 }
 
+/// A finished job of the same scenario file, method, seed, simulate and
+/// estimate settings whose estimate step succeeded: its estimate is this
+/// job's too (only the evaluation differs). Returns its folder or "".
+fs::path estimateDonor(const fs::path& results, const Job& job, const std::string& method,
+                       const std::string& scenario, const std::string& sequence) {
+  const std::string prefix = scenario + "." + method + ".s" + std::to_string(job.seed) + ".";
+  std::error_code ec;
+  const fs::path jobs = results / "jobs";
+  if (!fs::is_directory(jobs, ec)) return {};
+  std::vector<fs::path> candidates;
+  for (const auto& entry : fs::directory_iterator(jobs, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) == 0 && name != job.id) candidates.push_back(entry.path());
+  }
+  std::sort(candidates.begin(), candidates.end());  // the same donor whatever the directory order
+  for (const fs::path& dir : candidates) {
+    if (!fs::is_regular_file(dir / "estimate" / "trajectory.txt", ec) || !fs::is_regular_file(dir / "job.yaml", ec))
+      continue;
+    try {
+      const YAML::Node y = YAML::LoadFile((dir / "job.yaml").string());
+      if (y["simulate_set"].as<std::string>("") != overridesText(job.simulate_set) ||
+          y["estimate_set"].as<std::string>("") != overridesText(job.estimate_set) ||
+          y["sequence"].as<std::string>("") != sequence)
+        continue;
+      for (const auto& step : y["steps"])
+        if (step["name"].as<std::string>("") == "estimate") {
+          const std::string result = step["result"].as<std::string>("");
+          if (result == "exit code 0" || result.rfind("reused from ", 0) == 0) return dir;
+        }
+    } catch (const YAML::Exception&) {
+      continue;  // a damaged job.yaml is no donor
+    }
+  }
+  return {};
+}
+
 JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, RunContext& ctx) {
   const auto start = std::chrono::steady_clock::now();
   const std::string started = nowIso();
@@ -225,6 +262,19 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
     if (!failed_step.empty()) break;
     const std::string log = (staging / "logs" / (std::string(name) + ".log")).string();
     StepRecord rec{name, expand(*step, vars, job), "", 0.0};
+    if (std::string(name) == "estimate") {
+      // Only the evaluation changed since a finished job: re-score its estimate.
+      const fs::path donor = estimateDonor(results, job, c.methods[job.method].name,
+                                           c.scenarios[job.scenario].name, vars["sequence"]);
+      if (!donor.empty()) {
+        fs::copy(donor / "estimate", staging / "estimate", fs::copy_options::recursive);
+        std::error_code ec;
+        fs::copy_file(donor / "logs" / "estimate.log", log, ec);
+        rec.result = "reused from jobs/" + donor.filename().string();
+        steps.push_back(rec);
+        continue;
+      }
+    }
     const ChildResult r = runChild(rec.command, staging.string(), log, step->timeout_s);
     rec.result = r.describe();
     rec.wall_s = r.wall_s;
@@ -244,7 +294,14 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
 
   JobOutcome outcome;
   outcome.id = job.id;
-  const JsonValue m = parseJson(io::readFile(metrics.string()), metrics.string());
+  JsonValue m;
+  try {
+    m = parseJson(io::readFile(metrics.string()), metrics.string());
+  } catch (const Error& e) {  // an evaluate step that wrote garbage fails its job, not the campaign
+    cause = std::string("evaluate: ") + e.what();
+    io::writeFileAtomic(metrics.string(), failedMetricsJson("evaluate", cause));
+    m = parseJson(io::readFile(metrics.string()), metrics.string());
+  }
   const JsonValue* status = m.find("status");
   outcome.status = status && !status->text().empty() ? status->text() : "failed";
   if (const JsonValue* cs = m.find("cause")) outcome.cause = cs->text();

@@ -212,6 +212,78 @@ TEST(CampaignRunner, RunsResumesCachesSequencesAndRecordsFailures) {
   }
 }
 
+TEST(CampaignRunner, ReScoresAFinishedEstimateWhenOnlyTheEvaluationChanged) {
+  test::TempDir dir;
+  // estimate counts itself in <dir>/estimates; evaluate writes the alignment
+  // window start it was given as the MPE.
+  const std::string text = R"(name: rescore
+seeds: [1, 2]
+scenarios:
+  - {name: a, file: a.yaml}
+methods:
+  - good
+evaluate:
+  alignment: {start_s: 3}
+steps:
+  simulate:
+    command: [/bin/sh, -c, "mkdir -p {sequence} && echo x > {sequence}/groundtruth.txt"]
+  estimate:
+    command: [/bin/sh, -c, "echo x >> )" + dir.file("estimates") + R"( && mkdir estimate && echo {seed} > estimate/trajectory.txt"]
+  evaluate:
+    command: [/bin/sh, -c, "printf '{\"format\": \"evio-metrics/1\", \"status\": \"ok\", \"paper\": {\"mpe_percent\": %s}}' ${2#*=} > metrics.json", sh, "{evaluate_set}"]
+)";
+  io::writeFileAtomic(dir.file("c.yaml"), text);
+  RunnerOptions o;
+  o.results = dir.file("results");
+  o.workers = 1;
+  o.evio_binary = "/bin/true";
+  const Campaign first = loadCampaign(dir.file("c.yaml"));
+  for (const auto& out : runCampaign(first, expandJobs(first), o)) EXPECT_EQ(out.status, "ok") << out.cause;
+  EXPECT_EQ(io::readFile(dir.file("estimates")), "x\nx\n");
+
+  // Another alignment window: new jobs, scored again, estimated no more.
+  const Campaign second = loadCampaign(dir.file("c.yaml"), {"evaluate.alignment.start_s=4"});
+  const auto jobs = expandJobs(second);
+  for (const auto& out : runCampaign(second, jobs, o)) EXPECT_EQ(out.status, "ok") << out.cause;
+  EXPECT_EQ(io::readFile(dir.file("estimates")), "x\nx\n");
+  for (const auto& job : jobs) {
+    const fs::path folder = jobFolder(o.results, job);
+    EXPECT_EQ(io::readFile((folder / "estimate" / "trajectory.txt").string()), std::to_string(job.seed) + "\n");
+    EXPECT_NE(io::readFile((folder / "metrics.json").string()).find("\"mpe_percent\": 4"), std::string::npos);
+    EXPECT_NE(io::readFile((folder / "job.yaml").string()).find("reused from jobs/a.good.s" + std::to_string(job.seed)),
+              std::string::npos);
+  }
+
+  // Other estimate settings are a new estimate.
+  const Campaign third = loadCampaign(dir.file("c.yaml"), {"methods=[{name: good, set: {k: 2}}]"});
+  for (const auto& out : runCampaign(third, expandJobs(third), o)) EXPECT_EQ(out.status, "ok") << out.cause;
+  EXPECT_EQ(io::readFile(dir.file("estimates")), "x\nx\nx\nx\n");
+}
+
+TEST(CampaignRunner, AnEvaluateStepThatWritesGarbageFailsItsJobNotTheCampaign) {
+  test::TempDir dir;
+  io::writeFileAtomic(dir.file("c.yaml"), R"(name: garbage
+seeds: [1]
+scenarios:
+  - {name: a, file: a.yaml}
+methods:
+  - good
+steps:
+  simulate: {command: [/bin/sh, -c, "mkdir -p {sequence}"]}
+  estimate: {command: [/bin/sh, -c, "mkdir estimate"]}
+  evaluate: {command: [/bin/sh, -c, "echo not json > metrics.json"]}
+)");
+  const Campaign c = loadCampaign(dir.file("c.yaml"));
+  RunnerOptions o;
+  o.results = dir.file("results");
+  o.evio_binary = "/bin/true";
+  const auto outcomes = runCampaign(c, expandJobs(c), o);
+  ASSERT_EQ(outcomes.size(), 1u);
+  EXPECT_EQ(outcomes[0].status, "failed");
+  EXPECT_NE(outcomes[0].cause.find("evaluate: "), std::string::npos) << outcomes[0].cause;
+  EXPECT_NE(outcomes[0].cause.find("metrics.json:1"), std::string::npos) << outcomes[0].cause;
+}
+
 TEST(CampaignResults, CollectMergesJobsFromOtherResultFolders) {
   // Two "nodes" without a shared file system each run half of the jobs.
   test::TempDir dir;

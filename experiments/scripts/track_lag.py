@@ -1,0 +1,77 @@
+#!/usr/bin/python3
+"""Along-motion lag of feature tracks against their true positions.
+
+    experiments/scripts/track_lag.py <tracks.txt> <truth.txt> [--min-speed 50]
+
+<tracks.txt> is an `evio track` output (id t x y, pixels of one camera);
+<truth.txt> the same tracks' true positions written by
+`evio evaluate-tracks ... --truth-output <truth.txt>` (same ids and stamps,
+until each track's truth ends).
+
+For every sample k of a track with a true position p_k at t_k, the true image
+velocity v_k is the central difference (p_{k+1} - p_{k-1}) / (t_{k+1} - t_{k-1})
+of the true positions; the along-motion lag is
+
+    lag_px = -(x_k - p_k) . v_k / |v_k|     (px, > 0: the track trails the truth)
+    lag_s  = lag_px / |v_k|                 (s: the latency that explains it)
+
+Samples slower than --min-speed px/s (direction ill-defined) and the first
+sample of each track (the detection, exact by construction) are skipped.
+Prints the medians overall and per speed band.
+"""
+import argparse
+import statistics
+import sys
+from collections import defaultdict
+
+
+def read(path):
+    tracks = defaultdict(list)
+    with open(path) as f:
+        for line in f:
+            if not line.strip() or line.startswith("#"):
+                continue
+            i, t, x, y = line.split()
+            tracks[int(i)].append((float(t), float(x), float(y)))
+    return tracks
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("tracks")
+    ap.add_argument("truth")
+    ap.add_argument("--min-speed", type=float, default=50.0, help="px/s")
+    a = ap.parse_args()
+    est, truth = read(a.tracks), read(a.truth)
+    lags = []  # (speed px/s, lag px, lag s)
+    for i, tr in truth.items():
+        e = {round(t, 9): (x, y) for t, x, y in est.get(i, [])}
+        for k in range(1, len(tr) - 1):
+            t0, x0, y0 = tr[k - 1]
+            t, x, y = tr[k]
+            t1, x1, y1 = tr[k + 1]
+            if t1 <= t0 or round(t, 9) not in e:
+                continue
+            vx, vy = (x1 - x0) / (t1 - t0), (y1 - y0) / (t1 - t0)
+            speed = (vx * vx + vy * vy) ** 0.5
+            if speed < a.min_speed:
+                continue
+            ex, ey = e[round(t, 9)]
+            lag_px = -((ex - x) * vx + (ey - y) * vy) / speed
+            lags.append((speed, lag_px, lag_px / speed))
+    if not lags:
+        sys.exit("no samples faster than --min-speed with a true position")
+    print(f"samples {len(lags)}: median lag {statistics.median(l[1] for l in lags):.3f} px, "
+          f"median latency {1e3 * statistics.median(l[2] for l in lags):.2f} ms")
+    bands = [(50, 100), (100, 200), (200, 300), (300, 400), (400, 1e9)]
+    for lo, hi in bands:
+        sel = [l for l in lags if lo <= l[0] < hi]
+        if len(sel) < 20:
+            continue
+        print(f"  {lo:>4.0f}-{hi if hi < 1e9 else float('inf'):>4.0f} px/s: n {len(sel):6d}, "
+              f"lag {statistics.median(l[1] for l in sel):.3f} px, "
+              f"latency {1e3 * statistics.median(l[2] for l in sel):.2f} ms")
+
+
+if __name__ == "__main__":
+    main()

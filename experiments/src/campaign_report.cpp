@@ -160,6 +160,62 @@ CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& row
   return report;
 }
 
+std::string comparisonMarkdown(const CampaignReport& report) {
+  std::vector<std::string> scenarios, methods;
+  const auto add = [](std::vector<std::string>& v, const std::string& x) {
+    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+  };
+  for (const auto& g : report.groups) {
+    if (!g.sweep.empty()) return "";  // sweeps have their own rows per value
+    add(scenarios, g.scenario);
+    add(methods, g.method);
+  }
+  if (methods.size() < 2) return "";
+  const auto find = [&](const std::string& sc, const std::string& m) -> const ReportGroup* {
+    for (const auto& g : report.groups)
+      if (g.scenario == sc && g.method == m) return &g;
+    return nullptr;
+  };
+  std::string s = "\n## Comparison\n\nMedian MPE [%] / MYE [deg/m] over the successful runs (successful / "
+                  "finished runs); the last row is the mean over the scenarios of those medians, as the paper "
+                  "averages its sequences (over the scenarios where the method has a successful run).\n\n";
+  s += "| scenario |";
+  for (const auto& m : methods) s += " " + m + " |";
+  s += "\n|---|";
+  for (std::size_t i = 0; i < methods.size(); ++i) s += "---|";
+  s += "\n";
+  std::vector<double> mpe_sum(methods.size(), 0.0), mye_sum(methods.size(), 0.0);
+  std::vector<std::size_t> n(methods.size(), 0);
+  for (const auto& sc : scenarios) {
+    s += "| " + sc + " |";
+    for (std::size_t k = 0; k < methods.size(); ++k) {
+      const ReportGroup* g = find(sc, methods[k]);
+      if (!g) {
+        s += " – |";
+        continue;
+      }
+      const std::size_t finished = g->runs - g->pending;
+      const std::string runs = " (" + std::to_string(g->ok) + " / " + std::to_string(finished) + ")";
+      if (g->mpe_percent.count == 0) {
+        s.append(" –").append(runs).append(" |");
+        continue;
+      }
+      s.append(" ").append(fixed(g->mpe_percent.median, 2)).append(" / ");
+      s.append(fixed(g->mye_deg_per_m.median, 3)).append(runs).append(" |");
+      mpe_sum[k] += g->mpe_percent.median;
+      mye_sum[k] += g->mye_deg_per_m.median;
+      ++n[k];
+    }
+    s += "\n";
+  }
+  s += "| **average** |";
+  for (std::size_t k = 0; k < methods.size(); ++k)
+    s += n[k] ? " **" + fixed(mpe_sum[k] / static_cast<double>(n[k]), 2) + " / " +
+                    fixed(mye_sum[k] / static_cast<double>(n[k]), 3) + "** (" + std::to_string(n[k]) + " scenarios) |"
+              : " – |";
+  return s + "\n";
+}
+
 std::string reportMarkdown(const CampaignReport& report, const std::string& title,
                            const std::vector<std::string>& figures, const std::vector<std::string>& notes) {
   std::string s = "# " + title + "\n\n";
@@ -167,6 +223,7 @@ std::string reportMarkdown(const CampaignReport& report, const std::string& titl
        " jobs finished. Success = status ok (not diverged, not failed). Error statistics are over the "
        "successful runs: median [first quartile, third quartile]. ANEES: mean of the runs' average 6-dof pose "
        "NEES, with its two-sided 95 % χ² bounds for that many runs (consistent: inside).\n";
+  s += comparisonMarkdown(report);
   std::vector<std::string> scenarios;
   for (const auto& g : report.groups)
     if (std::find(scenarios.begin(), scenarios.end(), g.scenario) == scenarios.end()) scenarios.push_back(g.scenario);

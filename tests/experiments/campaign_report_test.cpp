@@ -70,5 +70,32 @@ TEST(CampaignReport, AggregatesRunsPerScenarioMethodAndSweep) {
   EXPECT_EQ(csv[2][2], "x=1");
 }
 
+TEST(CampaignReport, ComparisonTableHasMediansPerScenarioAndTheirMean) {
+  const std::string summary =
+      "job_id,scenario,method,sweep,seed,done,status,cause,alignment.describe,paper.mpe_percent,"
+      "paper.mye_deg_per_m,ate.position_m.rmse,ate.rotation_deg.rmse,completion.share,nees.available,"
+      "nees.mean_pose,rtf.available,rtf.median,rtf.max\n"
+      "a1,poster,eklt,,1,1,ok,,,1.0,0.10,,,1,false,,false,,\n"
+      "a2,poster,eklt,,2,1,ok,,,3.0,0.30,,,1,false,,false,,\n"
+      "b1,poster,klt,,1,1,ok,,,2.0,0.20,,,1,false,,false,,\n"
+      "b2,poster,klt,,2,1,diverged,,,90,9,,,1,false,,false,,\n"
+      "c1,shapes,eklt,,1,1,ok,,,4.0,0.40,,,1,false,,false,,\n"
+      "d1,shapes,klt,,1,1,failed,x,,,,,,,,,,,\n";
+  const CampaignReport r = aggregateSummary(parseCsv(summary));
+  const std::string md = comparisonMarkdown(r);
+  EXPECT_NE(md.find("| scenario | eklt | klt |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| poster | 2.00 / 0.200 (2 / 2) | 2.00 / 0.200 (1 / 2) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| shapes | 4.00 / 0.400 (1 / 1) | – (0 / 1) |"), std::string::npos) << md;
+  // eklt: mean of 2 and 4; klt: only poster has a successful run.
+  EXPECT_NE(md.find("| **average** | **3.00 / 0.300** (2 scenarios) | **2.00 / 0.200** (1 scenarios) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(reportMarkdown(r, "T", {}, {}).find("## Comparison"), std::string::npos);
+  // One method, or a sweep: no comparison table.
+  const CampaignReport one = aggregateSummary(parseCsv(
+      "job_id,scenario,method,sweep,seed,done,status,cause,paper.mpe_percent\na,s,m,n_e=1,1,1,ok,,1\n"));
+  EXPECT_EQ(comparisonMarkdown(one), "");
+}
+
 }  // namespace
 }  // namespace evio::experiments

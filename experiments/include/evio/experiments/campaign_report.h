@@ -53,7 +53,13 @@ struct CampaignReport {
 /// header lacks the fixed columns.
 CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& rows);
 
-/// The Markdown report: a table per scenario, then `figures` (file names
+/// The paper-style comparison (Markdown, "" unless the campaign has two or
+/// more methods and no sweep): one row per scenario, one column per method
+/// with the median MPE / MYE and successful / finished runs, and an average
+/// row (mean over scenarios of the medians).
+std::string comparisonMarkdown(const CampaignReport& report);
+
+/// The Markdown report: the comparison, a table per scenario, then `figures` (file names
 /// relative to the report) and `notes` (e.g. plots skipped and why).
 std::string reportMarkdown(const CampaignReport& report, const std::string& title,
                            const std::vector<std::string>& figures, const std::vector<std::string>& notes);

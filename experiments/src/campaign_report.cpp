@@ -178,7 +178,8 @@ std::string comparisonMarkdown(const CampaignReport& report) {
   };
   std::string s = "\n## Comparison\n\nMedian MPE [%] / MYE [deg/m] over the successful runs (successful / "
                   "finished runs); the last row is the mean over the scenarios of those medians, as the paper "
-                  "averages its sequences (over the scenarios where the method has a successful run).\n\n";
+                  "averages its sequences (over the scenarios where the method has a successful run). "
+                  "Where MPE is undefined (no distance travelled), the cell gives the median ATE RMSE.\n\n";
   s += "| scenario |";
   for (const auto& m : methods) s += " " + m + " |";
   s += "\n|---|";
@@ -196,8 +197,11 @@ std::string comparisonMarkdown(const CampaignReport& report) {
       }
       const std::size_t finished = g->runs - g->pending;
       const std::string runs = " (" + std::to_string(g->ok) + " / " + std::to_string(finished) + ")";
-      if (g->mpe_percent.count == 0) {
-        s.append(" –").append(runs).append(" |");
+      if (g->mpe_percent.count == 0) {  // no distance travelled (rotation only): the ATE instead
+        if (g->ate_position_m.count == 0) s.append(" –").append(runs).append(" |");
+        else
+          s.append(" ATE ").append(fixed(g->ate_position_m.median, 3)).append(" m, ")
+              .append(fixed(g->ate_rotation_deg.median, 2)).append("°").append(runs).append(" |");
         continue;
       }
       s.append(" ").append(fixed(g->mpe_percent.median, 2)).append(" / ");

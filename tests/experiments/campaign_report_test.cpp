@@ -80,12 +80,17 @@ TEST(CampaignReport, ComparisonTableHasMediansPerScenarioAndTheirMean) {
       "b1,poster,klt,,1,1,ok,,,2.0,0.20,,,1,false,,false,,\n"
       "b2,poster,klt,,2,1,diverged,,,90,9,,,1,false,,false,,\n"
       "c1,shapes,eklt,,1,1,ok,,,4.0,0.40,,,1,false,,false,,\n"
-      "d1,shapes,klt,,1,1,failed,x,,,,,,,,,,,\n";
+      "d1,shapes,klt,,1,1,failed,x,,,,,,,,,,,\n"
+      "e1,rotation,eklt,,1,1,ok,,,,,0.25,3.5,1,false,,false,,\n"
+      "f1,rotation,klt,,1,1,ok,,,,,0.05,0.5,1,false,,false,,\n";
   const CampaignReport r = aggregateSummary(parseCsv(summary));
   const std::string md = comparisonMarkdown(r);
   EXPECT_NE(md.find("| scenario | eklt | klt |"), std::string::npos) << md;
   EXPECT_NE(md.find("| poster | 2.00 / 0.200 (2 / 2) | 2.00 / 0.200 (1 / 2) |"), std::string::npos) << md;
   EXPECT_NE(md.find("| shapes | 4.00 / 0.400 (1 / 1) | – (0 / 1) |"), std::string::npos) << md;
+  // Rotation only: no MPE, the ATE instead (and no part of the average).
+  EXPECT_NE(md.find("| rotation | ATE 0.250 m, 3.50° (1 / 1) | ATE 0.050 m, 0.50° (1 / 1) |"), std::string::npos)
+      << md;
   // eklt: mean of 2 and 4; klt: only poster has a successful run.
   EXPECT_NE(md.find("| **average** | **3.00 / 0.300** (2 scenarios) | **2.00 / 0.200** (1 scenarios) |"),
             std::string::npos)

@@ -266,14 +266,15 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
       // Only the evaluation changed since a finished job: re-score its estimate.
       const fs::path donor = estimateDonor(results, job, c.methods[job.method].name,
                                            c.scenarios[job.scenario].name, vars["sequence"]);
-      if (!donor.empty()) {
-        fs::copy(donor / "estimate", staging / "estimate", fs::copy_options::recursive);
-        std::error_code ec;
-        fs::copy_file(donor / "logs" / "estimate.log", log, ec);
+      std::error_code ec;
+      if (!donor.empty()) fs::copy(donor / "estimate", staging / "estimate", fs::copy_options::recursive, ec);
+      if (!donor.empty() && !ec) {
+        fs::copy_file(donor / "logs" / "estimate.log", log, ec);  // the log is a courtesy
         rec.result = "reused from jobs/" + donor.filename().string();
         steps.push_back(rec);
         continue;
       }
+      fs::remove_all(staging / "estimate", ec);  // a failed copy: estimate afresh
     }
     const ChildResult r = runChild(rec.command, staging.string(), log, step->timeout_s);
     rec.result = r.describe();

@@ -20,19 +20,20 @@ sample of each track (the detection, exact by construction) are skipped.
 Prints the medians overall and per speed band.
 """
 import argparse
+import os
 import statistics
 import sys
 from collections import defaultdict
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plots"))
+from plot_tracks import load_tracks  # noqa: E402  (the project's reader of `id t x y` files)
+
 
 def read(path):
+    """Track id -> [(t, x, y), ...] in file order."""
     tracks = defaultdict(list)
-    with open(path) as f:
-        for line in f:
-            if not line.strip() or line.startswith("#"):
-                continue
-            i, t, x, y = line.split()
-            tracks[int(i)].append((float(t), float(x), float(y)))
+    for i, t, x, y in load_tracks(path):
+        tracks[int(i)].append((t, x, y))
     return tracks
 
 

@@ -92,7 +92,7 @@ for s in $SEQS; do
   done
 done
 
-python3 - "$OUT" "$SEQS" "$METHODS" <<'PY'
+/usr/bin/python3 - "$OUT" "$SEQS" "$METHODS" <<'PY'
 import json, os, sys
 out, seqs, methods = sys.argv[1], sys.argv[2].split(), sys.argv[3].split()
 names = {"eklt_frames": "EKLT (frames)", "eklt_reconstructed": "EKLT (reconstructed)", "klt": "KLT"}
@@ -104,35 +104,32 @@ def at_age(m, age):
 print("| sequence | tracker | tracks | evaluable | error mean / median (px) | age mean / median (s) "
       "| ended by error / truth / track | error at age 0.1 / 0.5 / 1.0 s, px (samples) |")
 print("|---|---|---:|---:|---|---|---|---|")
-for s in seqs:
-    for k in methods:
-        p = os.path.join(out, "%s_%s.json" % (s, k))
-        if not os.path.exists(p):
-            continue
-        m = json.load(open(p))
-        print("| %s | %s | %d | %d | %.2f / %.2f | %.3f / %.3f | %d / %d / %d | %s / %s / %s |" % (
-            s, names[k], m["estimated_tracks"], m["matched_tracks"], m["mean_error_px"], m["median_error_px"],
-            m["mean_feature_age_s"], m["median_feature_age_s"], m["ended_by_error"], m["ended_by_truth"],
-            m["ended_by_track"], at_age(m, 0.1), at_age(m, 0.5), at_age(m, 1.0)))
+def results(suffix):
+    """(sequence, tracker name, metrics) of every evaluated sequence × method."""
+    for s in seqs:
+        for k in methods:
+            p = os.path.join(out, "%s_%s%s.json" % (s, k, suffix))
+            if os.path.exists(p):
+                yield s, names[k], json.load(open(p))
+for s, name, m in results(""):
+    print("| %s | %s | %d | %d | %.2f / %.2f | %.3f / %.3f | %d / %d / %d | %s / %s / %s |" % (
+        s, name, m["estimated_tracks"], m["matched_tracks"], m["mean_error_px"], m["median_error_px"],
+        m["mean_feature_age_s"], m["median_feature_age_s"], m["ended_by_error"], m["ended_by_truth"],
+        m["ended_by_track"], at_age(m, 0.1), at_age(m, 0.5), at_age(m, 1.0)))
 print()
 print("| sequence | tracker | sub-pixel age (until error > 1 px) mean / median (s) | ended by error / truth / track |")
 print("|---|---|---|---|")
-for s in seqs:
-    for k in methods:
-        p = os.path.join(out, "%s_%s_1px.json" % (s, k))
-        if not os.path.exists(p):
-            continue
-        m = json.load(open(p))
-        print("| %s | %s | %.3f / %.3f | %d / %d / %d |" % (
-            s, names[k], m["mean_feature_age_s"], m["median_feature_age_s"], m["ended_by_error"],
-            m["ended_by_truth"], m["ended_by_track"]))
+for s, name, m in results("_1px"):
+    print("| %s | %s | %.3f / %.3f | %d / %d / %d |" % (
+        s, name, m["mean_feature_age_s"], m["median_feature_age_s"], m["ended_by_error"],
+        m["ended_by_truth"], m["ended_by_track"]))
 PY
 
 # Motion blur of the frames: exposure of frame k = 2 (stamp_k − start − k / rate)
 # (stamps are mid-exposure), image speed from truth/tracks.txt (ground-truth
 # point tracks, central differences at 200 Hz) at the track samples nearest
 # each frame stamp, blur length = speed × exposure.
-python3 - "$OUT" "$SEQS" <<'PY'
+/usr/bin/python3 - "$OUT" "$SEQS" <<'PY'
 import bisect, math, os, sys, yaml
 from collections import defaultdict
 out, seqs = sys.argv[1], sys.argv[2].split()

@@ -21,6 +21,7 @@ and plots.txt: one line per figure, "wrote NAME" or "skipped NAME: reason".
 import csv
 import math
 import os
+import re
 import sys
 
 import matplotlib
@@ -48,6 +49,11 @@ def number(text):
 def variant(row):
     """The group of a run within its scenario: (method, sweep)."""
     return (row["method"], row["sweep"])
+
+
+def natural_key(v):
+    """Sort key of a variant with digit runs compared as numbers (n_e 500 before 2000 before 10000)."""
+    return tuple(tuple(int(t) if t.isdigit() else t for t in re.split(r"(\d+)", part)) for part in v)
 
 
 def label(v, newline=True):
@@ -88,7 +94,7 @@ def box_plot(rows, scenarios, out, key, ylabel, name):
         return
     fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
     for ax, sc in zip(axes[0], scenarios):
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
         data = [[number(r[key]) for r in ok if r["scenario"] == sc and variant(r) == v] for v in variants]
         present = [(v, d) for v, d in zip(variants, data) if d]
         if present:
@@ -105,7 +111,7 @@ def box_plot(rows, scenarios, out, key, ylabel, name):
 def success_plot(rows, scenarios, out):
     fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
     for ax, sc in zip(axes[0], scenarios):
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
         bottom = np.zeros(len(variants))
         for status, colour in (("ok", "tab:green"), ("diverged", "tab:orange"), ("failed", "tab:red")):
             counts = np.array([sum(1 for r in rows if r["scenario"] == sc and variant(r) == v and
@@ -136,7 +142,7 @@ def error_plots(rows, scenarios, results, out):
                                ("t_s", "time [s]", "error_vs_time.png")):
         fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
         for ax, sc in zip(axes[0], scenarios):
-            variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+            variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
             for i, v in enumerate(variants):
                 colour = f"C{i}"
                 runs = [series[r["job_id"]] for r in rows
@@ -159,7 +165,7 @@ def error_plots(rows, scenarios, results, out):
     for sc in scenarios:
         fig, ax = plt.subplots(figsize=(5.5, 5))
         drawn_gt = False
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
         for i, v in enumerate(variants):
             runs = sorted((r for r in rows if r["scenario"] == sc and variant(r) == v and r["job_id"] in series),
                           key=lambda r: int(r["seed"]))
@@ -187,7 +193,7 @@ def nees_plot(rows, scenarios, series, groups, out):
         return
     fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
     for ax, sc in zip(axes[0], scenarios):
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc})
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
         for i, v in enumerate(variants):
             runs = [with_nees[r["job_id"]] for r in rows
                     if r["scenario"] == sc and variant(r) == v and r["job_id"] in with_nees]

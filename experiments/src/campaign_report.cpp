@@ -22,6 +22,33 @@ double number(const std::string& text) {
   return io::parseFiniteDouble(text, &v) ? v : kNaN;
 }
 
+/// Text order with runs of digits compared as numbers ("n_e=500" before
+/// "n_e=2000" before "n_e=10000"), so sweeps read in their natural order.
+bool naturalLess(const std::string& a, const std::string& b) {
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (digit(a[i]) && digit(b[j])) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && digit(a[ie])) ++ie;
+      while (je < b.size() && digit(b[je])) ++je;
+      std::size_t ia = i, jb = j;  // skip leading zeros, then the longer number is larger
+      while (ia + 1 < ie && a[ia] == '0') ++ia;
+      while (jb + 1 < je && b[jb] == '0') ++jb;
+      if (ie - ia != je - jb) return ie - ia < je - jb;
+      const int c = a.compare(ia, ie - ia, b, jb, je - jb);
+      if (c != 0) return c < 0;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
 std::string fixed(double v, int digits) {
   if (!std::isfinite(v)) return "–";
   char buf[48];
@@ -148,14 +175,15 @@ CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& row
       g.anees = g.anees_lower = g.anees_upper = kNaN;
     }
   }
-  // Scenarios in order of first appearance; within one, by method and sweep.
+  // Scenarios in order of first appearance; within one, by method and sweep
+  // (sweep values in natural order).
   std::map<std::string, std::size_t> scenario_order;
   for (const auto& g : report.groups) scenario_order.emplace(g.scenario, scenario_order.size());
   std::stable_sort(report.groups.begin(), report.groups.end(), [&](const ReportGroup& a, const ReportGroup& b) {
     const std::size_t sa = scenario_order[a.scenario], sb = scenario_order[b.scenario];
     if (sa != sb) return sa < sb;
     if (a.method != b.method) return a.method < b.method;
-    return a.sweep < b.sweep;
+    return naturalLess(a.sweep, b.sweep);
   });
   return report;
 }

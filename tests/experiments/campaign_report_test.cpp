@@ -102,5 +102,18 @@ TEST(CampaignReport, ComparisonTableHasMediansPerScenarioAndTheirMean) {
   EXPECT_EQ(comparisonMarkdown(one), "");
 }
 
+
+TEST(CampaignReport, SweepValuesAreInNaturalOrder) {
+  // Lexicographic order would put 10000 before 2000 and 500 last.
+  std::string summary = "job_id,scenario,method,sweep,seed,done,status\n";
+  for (const char* n : {"10000", "500", "2000", "0500x", "1000"})
+    summary += std::string("j") + n + ",poster,eklt,sync.n_e=" + n + ",1,0,\n";
+  const CampaignReport r = aggregateSummary(parseCsv(summary));
+  ASSERT_EQ(r.groups.size(), 5u);
+  const std::vector<std::string> expected = {"sync.n_e=500", "sync.n_e=0500x", "sync.n_e=1000", "sync.n_e=2000",
+                                             "sync.n_e=10000"};
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(r.groups[i].sweep, expected[i]) << i;
+}
+
 }  // namespace
 }  // namespace evio::experiments

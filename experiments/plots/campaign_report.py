@@ -243,13 +243,16 @@ def rtf_plot(rows, results, out):
                 xs.append(s["event_rate_hz"])
                 ys.append(s["rtf"])
         if xs:
-            ax.scatter(np.concatenate(xs), np.concatenate(ys), s=4, alpha=0.4, color=f"C{i}", label=m)
-            any_drawn = True
+            x, y = np.concatenate(xs), np.concatenate(ys)
+            keep = y > 0  # a logarithmic axis: RTF spans 0.1 to 100 across methods and machines
+            ax.scatter(x[keep], y[keep], s=4, alpha=0.4, color=f"C{i}", label=m)
+            any_drawn = bool(keep.any()) or any_drawn
     if not any_drawn:
         plt.close(fig)
         note("skipped rtf_vs_event_rate.png: no job has timing.txt (metrics_rtf.csv)")
         return
     ax.axhline(1.0, color="k", lw=0.8, ls="--")
+    ax.set_yscale("log")
     ax.set_xlabel("event rate [events/s]")
     ax.set_ylabel("real-time factor (0.2 s intervals)")
     ax.grid(alpha=0.3)

@@ -150,20 +150,26 @@ Alignment align(const Association& association, TimeNs groundtruth_start_ns, con
     x.push_back(poses[k].T_W_es.translation());
     y.push_back(poses[k].T_W_gt.translation());
   }
-  // Is the rotation determined by the positions?
-  Vec3 mx = Vec3::Zero();
-  for (const auto& p : x) mx += p;
-  mx /= static_cast<double>(x.size());
-  Mat3 scatter = Mat3::Zero();
-  for (const auto& p : x) scatter += (p - mx) * (p - mx).transpose();
-  scatter /= static_cast<double>(x.size());
-  bool determined = false;
-  if (a.type == AlignmentType::kPosYaw) {
-    determined = std::sqrt(std::max(0.0, scatter(0, 0) + scatter(1, 1))) >= options.min_spread_m;
-  } else {
+  // Is the rotation determined by the positions? Only if both trajectories
+  // spread: an estimate drifting while the truth stands still (a hover, a
+  // rotation in place) would otherwise choose the rotation from its drift.
+  const auto mean = [](const std::vector<Vec3>& points) {
+    Vec3 m = Vec3::Zero();
+    for (const auto& p : points) m += p;
+    return Vec3(m / static_cast<double>(points.size()));
+  };
+  const auto spreads = [&](const std::vector<Vec3>& points) {
+    const Vec3 m = mean(points);
+    Mat3 scatter = Mat3::Zero();
+    for (const auto& p : points) scatter += (p - m) * (p - m).transpose();
+    scatter /= static_cast<double>(points.size());
+    if (a.type == AlignmentType::kPosYaw)  // the horizontal RMS spread
+      return std::sqrt(std::max(0.0, scatter(0, 0) + scatter(1, 1))) >= options.min_spread_m;
     const Eigen::SelfAdjointEigenSolver<Mat3> es(scatter, Eigen::EigenvaluesOnly);
-    determined = std::sqrt(std::max(0.0, es.eigenvalues()(1))) >= options.min_spread_m;  // ascending order
-  }
+    return std::sqrt(std::max(0.0, es.eigenvalues()(1))) >= options.min_spread_m;  // a plane: 2nd of ascending
+  };
+  const Vec3 mx = mean(x);
+  const bool determined = spreads(x) && spreads(y);
   if (determined) {
     a.transform = umeyama(x, y, a.type);
     return a;
@@ -175,10 +181,7 @@ Alignment align(const Association& association, TimeNs groundtruth_start_ns, con
   for (std::size_t k : window) M += poses[k].T_W_es.rotation() * poses[k].T_W_gt.rotation().transpose();
   a.rotation_from_orientation = true;
   a.transform.R = bestRotation(M, a.type);
-  Vec3 my = Vec3::Zero();
-  for (const auto& p : y) my += p;
-  my /= static_cast<double>(y.size());
-  a.transform.t = my - a.transform.R * mx;
+  a.transform.t = mean(y) - a.transform.R * mx;
   return a;
 }
 

@@ -151,6 +151,27 @@ TEST(TrajectoryAlignment, HoverTakesTheRotationFromOrientations) {
   EXPECT_THROW(align(a, gt.front().t_ns, sim3), Error);
 }
 
+TEST(TrajectoryAlignment, AnEstimateDriftingOverAStillTruthDoesNotChooseTheYaw) {
+  // The truth turns in place; the estimate (the truth moved by a known yaw
+  // and offset) drifts 1 m sideways. The drift spreads the estimate's
+  // positions, but the truth's do not determine a yaw: it must come from
+  // the orientations, exactly.
+  Trajectory gt;
+  for (int k = 0; k <= 500; ++k)
+    gt.push_back({TimeNs{k} * 10'000'000, Pose(so3::exp(Vec3(0.02, 0.01, 0.01 * k)), Vec3(0, -0.8, 1.5))});
+  Similarity S;
+  S.R = rotationZ(-30.0 * kDeg);
+  S.t = Vec3(0.5, 0, 0);
+  Trajectory es = transformedBack(gt, S);
+  for (std::size_t k = 0; k < es.size(); ++k)
+    es[k].pose = Pose(es[k].pose.quaternion(), es[k].pose.translation() + Vec3(0.002 * static_cast<double>(k), 0, 0));
+  AlignmentOptions o;
+  o.min_spread_m = 0.2;
+  const Alignment al = align(associateExact(es, gt), gt.front().t_ns, o);
+  EXPECT_TRUE(al.rotation_from_orientation);
+  EXPECT_LT((al.transform.R - S.R).norm(), 1e-9);
+}
+
 TEST(TrajectoryAlignment, NoneIsTheIdentityAndAnEmptyWindowIsAnError) {
   const Trajectory gt = test::wavyTrajectory(5.0);
   const Association a = associateExact(gt, gt);

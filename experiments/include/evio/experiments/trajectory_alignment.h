@@ -49,7 +49,7 @@ struct AlignmentOptions {
   int first_n = 0;               ///< window "first": number of associated poses (> 1)
   double start_s = 0.0;          ///< window "time": start, s after the first ground-truth time
   double end_s = 0.0;            ///< window "time": end, s after the first ground-truth time
-  double min_spread_m = 1e-3;    ///< RMS position spread below which the rotation comes from orientations, m
+  double min_spread_m = 1e-3;    ///< RMS position spread (of the estimate or the truth) below which the rotation comes from orientations, m
 
   template <class V>
   void fields(V& v) {

@@ -22,7 +22,7 @@ using config::detail::throwAt;
 
 const std::set<std::string> kPlaceholders = {"evio",     "bin",      "campaign_dir", "scenario", "scenario_file",
                                              "method",   "seed",     "sequence",     "job",      "simulate_set",
-                                             "estimate_set", "evaluate_set"};
+                                             "estimate_set", "evaluate_set", "estimator_config", "method_option"};
 
 /// Checks a map's keys against `allowed` (unknown and duplicate keys are errors).
 void checkKeys(const Document& doc, const YAML::Node& node, const std::string& path,
@@ -139,7 +139,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
   for (const auto& o : overrides) config::applyOverride(doc, o);
   const YAML::Node root = doc.root;
   checkKeys(doc, root, "",
-            {"name", "seeds", "scenarios", "methods", "sweeps", "evaluate", "cache", "steps", "slurm"});
+            {"name", "seeds", "scenarios", "methods", "sweeps", "evaluate", "cache", "estimator_config", "steps",
+             "slurm"});
   Campaign c;
   c.file = fs::absolute(path).lexically_normal().string();
   c.dir = fs::path(c.file).parent_path().string();
@@ -231,6 +232,11 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
     }
     if (const YAML::Node cache = optional(root, "cache"); cache.IsDefined())
       c.cache = absolute(c.dir, scalarAs<std::string>(doc, cache, "cache"));
+    if (const YAML::Node ec = optional(root, "estimator_config"); ec.IsDefined()) {
+      c.estimator_config = absolute(c.dir, scalarAs<std::string>(doc, ec, "estimator_config"));
+      if (!fs::is_regular_file(c.estimator_config))
+        throwAt(doc, ec, "estimator_config", "no such file: " + c.estimator_config);
+    }
 
     YAML::Node steps = optional(root, "steps");
     if (steps.IsDefined()) checkKeys(doc, steps, "steps", {"simulate", "estimate", "evaluate"});
@@ -239,8 +245,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
                       {"{evio}", "simulate", "{scenario_file}", "-o", "{sequence}", "-q", "--set", "seed={seed}",
                        "{simulate_set}"});
     c.estimate = step(doc, steps, "estimate",
-                      {"{evio}", "estimate", "{sequence}", "--method", "{method}", "-o", "estimate", "-q", "--set",
-                       "seed={seed}", "{estimate_set}"});
+                      {"{evio}", "estimate", "{sequence}", "{estimator_config}", "{method_option}", "-o", "estimate",
+                       "-q", "--set", "seed={seed}", "{estimate_set}"});
     c.evaluate_step = step(doc, steps, "evaluate",
                            {"{evio}", "evaluate", "estimate", "{sequence}", "-o", "metrics.json", "-q",
                             "{evaluate_set}"});

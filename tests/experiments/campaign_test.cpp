@@ -8,6 +8,8 @@
 #include <map>
 #include <set>
 
+#include <yaml-cpp/yaml.h>
+
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/experiments/campaign_results.h"
@@ -210,6 +212,58 @@ TEST(CampaignRunner, RunsResumesCachesSequencesAndRecordsFailures) {
       EXPECT_EQ(rows[r].back(), rows[r][4]);  // mpe = seed
     }
   }
+}
+
+TEST(CampaignRunner, DefaultEstimateCommandPassesTheEstimatorConfigAndTheMethod) {
+  // estimator_config (relative to the campaign file) becomes --config <absolute
+  // path>; --method <name> is passed unless the method's settings set
+  // `method` themselves (a variant named for what it changes).
+  test::TempDir dir;
+  fs::create_directories(dir.file("tuning"));
+  io::writeFileAtomic(dir.file("tuning/sim.yaml"), "sync: {n_e: 3200}\n");
+  io::writeFileAtomic(dir.file("c.yaml"), R"(name: defaults
+seeds: [1]
+scenarios:
+  - {name: a, file: a.yaml}
+methods:
+  - klt-vio
+  - name: fewer_features
+    set: {method: eklt-vio, frontend.eklt.max_features: 20}
+estimator_config: tuning/sim.yaml
+steps:
+  simulate: {command: [/bin/sh, -c, "mkdir -p {sequence}"]}
+)");
+  const Campaign c = loadCampaign(dir.file("c.yaml"));
+  EXPECT_EQ(c.estimator_config, fs::path(dir.file("tuning/sim.yaml")).lexically_normal().string());
+  RunnerOptions o;
+  o.results = dir.file("results");
+  o.workers = 1;
+  o.evio_binary = "/bin/true";  // every step "succeeds" without output: the jobs fail at evaluate, commands recorded
+  const auto jobs = expandJobs(c);
+  (void)runCampaign(c, jobs, o);
+  std::map<std::string, std::string> estimate_command;
+  for (const auto& job : jobs) {
+    const YAML::Node y = YAML::LoadFile((fs::path(jobFolder(o.results, job)) / "job.yaml").string());
+    for (const auto& step : y["steps"])
+      if (step["name"].as<std::string>() == "estimate") {
+        std::string line;
+        for (const auto& arg : step["command"]) line += (line.empty() ? "" : " ") + arg.as<std::string>();
+        estimate_command[c.methods[job.method].name] = line;
+      }
+  }
+  const std::string seq = jobs[0].sequence_key;
+  EXPECT_EQ(estimate_command["klt-vio"],
+            "/bin/true estimate " + (fs::path(o.results) / "sequences" / seq).string() + " --config " +
+                c.estimator_config + " --method klt-vio -o estimate -q --set seed=1");
+  EXPECT_EQ(estimate_command["fewer_features"],
+            "/bin/true estimate " + (fs::path(o.results) / "sequences" / seq).string() + " --config " +
+                c.estimator_config +
+                " -o estimate -q --set seed=1 --set method=eklt-vio --set frontend.eklt.max_features=20");
+  // A missing configuration is an error at load time, naming the key.
+  io::writeFileAtomic(dir.file("bad.yaml"), "name: x\nseeds: [1]\nscenarios: [{name: a, file: a.yaml}]\n"
+                                            "methods: [klt-vio]\nestimator_config: nowhere.yaml\n");
+  const std::string e = errorOf([&] { loadCampaign(dir.file("bad.yaml")); });
+  EXPECT_NE(e.find("bad.yaml:5: estimator_config"), std::string::npos) << e;
 }
 
 TEST(CampaignRunner, ReScoresAFinishedEstimateWhenOnlyTheEvaluationChanged) {

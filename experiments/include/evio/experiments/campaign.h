@@ -41,9 +41,15 @@
 /// {scenario_file}, {method}, {seed}, {sequence} (the sequence folder being
 /// simulated or read), {job} (the job's folder). An argument that is exactly
 /// {simulate_set}, {estimate_set} or {evaluate_set} expands to the step's
-/// overrides as "--set key=value" pairs (none when empty). Defaults:
+/// overrides as "--set key=value" pairs (none when empty); {estimator_config}
+/// to "--config <file>" when the campaign names one (`estimator_config:`,
+/// relative to the campaign file), else nothing; {method_option} to
+/// "--method <method name>" unless the job's estimator settings set `method`
+/// themselves (a method named for its variant, e.g. `features15` with
+/// `set: {method: eklt-vio, …}`), else nothing. Defaults:
 ///   simulate: {evio} simulate {scenario_file} -o {sequence} -q --set seed={seed} {simulate_set}
-///   estimate: {evio} estimate {sequence} --method {method} -o estimate -q --set seed={seed} {estimate_set}
+///   estimate: {evio} estimate {sequence} {estimator_config} {method_option} -o estimate -q --set seed={seed}
+///             {estimate_set}
 ///   evaluate: {evio} evaluate estimate {sequence} -o metrics.json -q {evaluate_set}
 /// The estimate step must write the estimate folder (estimate_files.h) into
 /// ./estimate; the evaluate step must write ./metrics.json.
@@ -102,6 +108,7 @@ struct Campaign {
   std::vector<SweepAxis> sweeps;
   Overrides evaluate;  ///< flattened EvaluationOptions overrides
   std::string cache;   ///< absolute, or empty: <results>/sequences
+  std::string estimator_config;  ///< absolute path of the estimator configuration, or empty (its defaults)
   CampaignStep simulate, estimate, evaluate_step;
   SlurmSettings slurm;
 };

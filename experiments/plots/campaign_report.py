@@ -21,7 +21,6 @@ and plots.txt: one line per figure, "wrote NAME" or "skipped NAME: reason".
 import csv
 import math
 import os
-import re
 import sys
 
 import matplotlib
@@ -51,9 +50,16 @@ def variant(row):
     return (row["method"], row["sweep"])
 
 
-def natural_key(v):
-    """Sort key of a variant with digit runs compared as numbers (n_e 500 before 2000 before 10000)."""
-    return tuple(tuple(int(t) if t.isdigit() else t for t in re.split(r"(\d+)", part)) for part in v)
+def variant_key(v):
+    """Sort key of a variant, as the C++ report orders its tables: the method
+    as text, then the sweep key by key, numeric values by value, then the text."""
+    method, sweep = v
+    items = []
+    for kv in sweep.split(";") if sweep else []:
+        key, _, value = kv.partition("=")
+        num = number(value)
+        items.append((key, 0, num, "") if num is not None else (key, 1, 0.0, value))
+    return (method, items, sweep)
 
 
 def label(v, newline=True):
@@ -94,7 +100,7 @@ def box_plot(rows, scenarios, out, key, ylabel, name):
         return
     fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
     for ax, sc in zip(axes[0], scenarios):
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=variant_key)
         data = [[number(r[key]) for r in ok if r["scenario"] == sc and variant(r) == v] for v in variants]
         present = [(v, d) for v, d in zip(variants, data) if d]
         if present:
@@ -111,7 +117,7 @@ def box_plot(rows, scenarios, out, key, ylabel, name):
 def success_plot(rows, scenarios, out):
     fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
     for ax, sc in zip(axes[0], scenarios):
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=variant_key)
         bottom = np.zeros(len(variants))
         for status, colour in (("ok", "tab:green"), ("diverged", "tab:orange"), ("failed", "tab:red")):
             counts = np.array([sum(1 for r in rows if r["scenario"] == sc and variant(r) == v and
@@ -142,7 +148,7 @@ def error_plots(rows, scenarios, results, out):
                                ("t_s", "time [s]", "error_vs_time.png")):
         fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
         for ax, sc in zip(axes[0], scenarios):
-            variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
+            variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=variant_key)
             for i, v in enumerate(variants):
                 colour = f"C{i}"
                 runs = [series[r["job_id"]] for r in rows
@@ -165,7 +171,7 @@ def error_plots(rows, scenarios, results, out):
     for sc in scenarios:
         fig, ax = plt.subplots(figsize=(5.5, 5))
         drawn_gt = False
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=variant_key)
         for i, v in enumerate(variants):
             runs = sorted((r for r in rows if r["scenario"] == sc and variant(r) == v and r["job_id"] in series),
                           key=lambda r: int(r["seed"]))
@@ -193,7 +199,7 @@ def nees_plot(rows, scenarios, series, groups, out):
         return
     fig, axes = plt.subplots(1, len(scenarios), figsize=(4.5 * len(scenarios), 4), squeeze=False)
     for ax, sc in zip(axes[0], scenarios):
-        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=natural_key)
+        variants = sorted({variant(r) for r in rows if r["scenario"] == sc}, key=variant_key)
         for i, v in enumerate(variants):
             runs = [with_nees[r["job_id"]] for r in rows
                     if r["scenario"] == sc and variant(r) == v and r["job_id"] in with_nees]
@@ -245,11 +251,12 @@ def rtf_plot(rows, results, out):
         if xs:
             x, y = np.concatenate(xs), np.concatenate(ys)
             keep = y > 0  # a logarithmic axis: RTF spans 0.1 to 100 across methods and machines
-            ax.scatter(x[keep], y[keep], s=4, alpha=0.4, color=f"C{i}", label=m)
-            any_drawn = bool(keep.any()) or any_drawn
+            if keep.any():
+                ax.scatter(x[keep], y[keep], s=4, alpha=0.4, color=f"C{i}", label=m)
+                any_drawn = True
     if not any_drawn:
         plt.close(fig)
-        note("skipped rtf_vs_event_rate.png: no job has timing.txt (metrics_rtf.csv)")
+        note("skipped rtf_vs_event_rate.png: no job has a positive real-time factor (timing.txt → metrics_rtf.csv)")
         return
     ax.axhline(1.0, color="k", lw=0.8, ls="--")
     ax.set_yscale("log")

@@ -22,31 +22,33 @@ double number(const std::string& text) {
   return io::parseFiniteDouble(text, &v) ? v : kNaN;
 }
 
-/// Text order with runs of digits compared as numbers ("n_e=500" before
-/// "n_e=2000" before "n_e=10000"), so sweeps read in their natural order.
-bool naturalLess(const std::string& a, const std::string& b) {
-  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
-  std::size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (digit(a[i]) && digit(b[j])) {
-      std::size_t ie = i, je = j;
-      while (ie < a.size() && digit(a[ie])) ++ie;
-      while (je < b.size() && digit(b[je])) ++je;
-      std::size_t ia = i, jb = j;  // skip leading zeros, then the longer number is larger
-      while (ia + 1 < ie && a[ia] == '0') ++ia;
-      while (jb + 1 < je && b[jb] == '0') ++jb;
-      if (ie - ia != je - jb) return ie - ia < je - jb;
-      const int c = a.compare(ia, ie - ia, b, jb, je - jb);
-      if (c != 0) return c < 0;
-      i = ie;
-      j = je;
-    } else {
-      if (a[i] != b[j]) return a[i] < b[j];
-      ++i;
-      ++j;
+/// Order of two sweep cells "k=v;k=v…": key by key, a value that parses as
+/// a number by its value (n_e 500 before 2000 before 10000, 0.0005 before
+/// 0.001 before 0.01), other values as text; the whole text breaks ties.
+bool sweepLess(const std::string& a, const std::string& b) {
+  const auto split = [](const std::string& s) {
+    std::vector<std::pair<std::string, std::string>> kv;
+    std::size_t start = 0;
+    while (start <= s.size() && !s.empty()) {
+      const std::size_t end = std::min(s.find(';', start), s.size());
+      const std::string item = s.substr(start, end - start);
+      const std::size_t eq = item.find('=');
+      kv.emplace_back(item.substr(0, eq), eq == std::string::npos ? std::string() : item.substr(eq + 1));
+      start = end + 1;
     }
+    return kv;
+  };
+  const auto ka = split(a), kb = split(b);
+  for (std::size_t i = 0; i < std::min(ka.size(), kb.size()); ++i) {
+    if (ka[i].first != kb[i].first) return ka[i].first < kb[i].first;
+    double va = 0.0, vb = 0.0;
+    const bool na = io::parseFiniteDouble(ka[i].second, &va), nb = io::parseFiniteDouble(kb[i].second, &vb);
+    if (na && nb && va != vb) return va < vb;
+    if (na != nb) return na;  // numbers before text
+    if (!na && ka[i].second != kb[i].second) return ka[i].second < kb[i].second;
   }
-  return a.size() - i < b.size() - j;
+  if (ka.size() != kb.size()) return ka.size() < kb.size();
+  return a < b;
 }
 
 std::string fixed(double v, int digits) {
@@ -176,14 +178,14 @@ CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& row
     }
   }
   // Scenarios in order of first appearance; within one, by method and sweep
-  // (sweep values in natural order).
+  // (sweep values in numeric order).
   std::map<std::string, std::size_t> scenario_order;
   for (const auto& g : report.groups) scenario_order.emplace(g.scenario, scenario_order.size());
   std::stable_sort(report.groups.begin(), report.groups.end(), [&](const ReportGroup& a, const ReportGroup& b) {
     const std::size_t sa = scenario_order[a.scenario], sb = scenario_order[b.scenario];
     if (sa != sb) return sa < sb;
     if (a.method != b.method) return a.method < b.method;
-    return naturalLess(a.sweep, b.sweep);
+    return sweepLess(a.sweep, b.sweep);
   });
   return report;
 }

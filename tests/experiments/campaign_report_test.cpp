@@ -103,15 +103,16 @@ TEST(CampaignReport, ComparisonTableHasMediansPerScenarioAndTheirMean) {
 }
 
 
-TEST(CampaignReport, SweepValuesAreInNaturalOrder) {
-  // Lexicographic order would put 10000 before 2000 and 500 last.
+TEST(CampaignReport, SweepValuesAreInNumericOrder) {
+  // Text order would put 10000 before 2000, 0.01 before 0.0005 and 5e-4 last.
   std::string summary = "job_id,scenario,method,sweep,seed,done,status\n";
-  for (const char* n : {"10000", "500", "2000", "0500x", "1000"})
-    summary += std::string("j") + n + ",poster,eklt,sync.n_e=" + n + ",1,0,\n";
+  for (const char* v : {"n_e=10000", "n_e=500", "n_e=2000", "n_e=0500.5", "n_e=1000", "r=0.01", "r=5e-4",
+                        "r=0.001", "r=off"})
+    summary += std::string("j") + v + ",poster,eklt," + v + ",1,0,\n";
   const CampaignReport r = aggregateSummary(parseCsv(summary));
-  ASSERT_EQ(r.groups.size(), 5u);
-  const std::vector<std::string> expected = {"sync.n_e=500", "sync.n_e=0500x", "sync.n_e=1000", "sync.n_e=2000",
-                                             "sync.n_e=10000"};
+  ASSERT_EQ(r.groups.size(), 9u);
+  const std::vector<std::string> expected = {"n_e=500", "n_e=0500.5", "n_e=1000", "n_e=2000", "n_e=10000",
+                                             "r=5e-4",  "r=0.001",    "r=0.01",   "r=off"};
   for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(r.groups[i].sweep, expected[i]) << i;
 }
 

@@ -29,20 +29,41 @@ std::vector<std::string> asArguments(const Overrides& overrides) {
   return out;
 }
 
-/// The value after "--config" in the estimate command, or "" (the defaults).
+/// The estimator configuration the estimate step passes: the campaign's
+/// estimator_config, or the value after "--config" in a custom command, or
+/// "" (the defaults).
 std::string estimatorConfig(const Campaign& c) {
+  if (!c.estimator_config.empty()) return c.estimator_config;
   const auto& cmd = c.estimate.command;
   const auto it = std::find(cmd.begin(), cmd.end(), "--config");
   return it != cmd.end() && it + 1 != cmd.end() ? *(it + 1) : std::string();
 }
 
-/// What `evio estimate --config <config> --set …` does with the settings
-/// (estimate_command.cpp): the method from the settings, then every key filled.
-void checkEstimatorSettings(const std::string& config_file, const Overrides& estimate_set, const std::string& method) {
+/// The method name the estimate command passes as --method for this job:
+/// {method_option} passes it unless the job's settings set `method`; a
+/// literal {method} (a custom "--method {method}") always does; else none.
+std::string commandMethod(const Campaign& c, const Job& job) {
+  const auto& cmd = c.estimate.command;
+  const bool sets_method = std::any_of(job.estimate_set.begin(), job.estimate_set.end(),
+                                       [](const auto& kv) { return kv.first == "method"; });
+  const bool option = std::find(cmd.begin(), cmd.end(), "{method_option}") != cmd.end();
+  const bool literal = std::find(cmd.begin(), cmd.end(), "{method}") != cmd.end();
+  return literal || (option && !sets_method) ? c.methods[job.method].name : std::string();
+}
+
+/// What `evio estimate [--config <config>] [--method <name>] --set …` does
+/// with the settings (estimate_command.cpp): --method wins, else the
+/// settings' `method`; then every key is filled and checked.
+void checkEstimatorSettings(const std::string& config_file, const Overrides& estimate_set,
+                            const std::string& command_method) {
   config::Document doc = config_file.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(config_file);
   for (const auto& o : asArguments(estimate_set)) config::applyOverride(doc, o);
-  std::string m = method;
-  if (const YAML::Node node = doc.root["method"]; node.IsDefined()) m = node.as<std::string>();
+  std::string m = command_method;
+  if (m.empty()) {
+    const YAML::Node node = doc.root["method"];
+    if (!node.IsDefined()) throw Error("no method: neither the command nor the settings give one");
+    m = config::detail::scalarAs<std::string>(doc, node, "method");
+  }
   config::applyOverride(doc, "method=" + m);
   estimator::PipelineOptions options = estimator::PipelineOptions::forMethod(m);
   config::fill(doc, "", options);
@@ -57,22 +78,25 @@ TEST(ShippedCampaigns, EveryJobHasAValidScenarioAndEstimatorSettings) {
     SCOPED_TRACE(entry.path().string());
     const Campaign c = loadCampaign(entry.path().string());
     std::string config = estimatorConfig(c);
-    if (!config.empty() && fs::path(config).is_relative()) config = (root / config).string();  // run from the repository
+    if (!config.empty() && fs::path(config).is_relative()) config = (root / config).string();  // a custom command's path
     std::set<std::string> scenarios_seen, settings_seen;
     for (const Job& job : expandJobs(c)) {
       const CampaignScenario& sc = c.scenarios[job.scenario];
       if (!sc.file.empty() && scenarios_seen.insert(sc.file + "|" + overridesText(job.simulate_set)).second) {
-        SCOPED_TRACE(job.id);
+        // As the simulate step: --set seed=<seed> before the scenario's settings.
+        std::vector<std::string> overrides = {"seed=" + std::to_string(job.seed)};
+        for (const auto& o : asArguments(job.simulate_set)) overrides.push_back(o);
         try {
-          (void)simulator::loadScenario(sc.file, asArguments(job.simulate_set), root.string());
-        } catch (const Error& e) {
+          (void)simulator::loadScenario(sc.file, overrides, root.string());
+        } catch (const std::exception& e) {  // evio::Error, or a YAML exception that escaped
           ADD_FAILURE() << job.id << ": " << e.what();
         }
       }
-      if (settings_seen.insert(overridesText(job.estimate_set)).second) {
+      const std::string command_method = commandMethod(c, job);
+      if (settings_seen.insert(command_method + "|" + overridesText(job.estimate_set)).second) {
         try {
-          checkEstimatorSettings(config, job.estimate_set, c.methods[job.method].name);
-        } catch (const Error& e) {
+          checkEstimatorSettings(config, job.estimate_set, command_method);
+        } catch (const std::exception& e) {
           ADD_FAILURE() << job.id << ": " << e.what();
         }
       }

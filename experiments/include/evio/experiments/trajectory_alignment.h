@@ -16,9 +16,10 @@
 ///   - sim3: as se3 and s = trace(D·S) / Σ‖x_k‖².
 ///   - none: the identity.
 /// In every case t = ȳ − s·R·x̄ (the means of the window's positions).
-/// When the window's positions do not determine the rotation (posyaw: an
-/// RMS horizontal spread below min_spread_m, e.g. a hover; se3: positions
-/// that do not span a plane, second RMS singular value below min_spread_m),
+/// When the window's positions do not determine the rotation (the estimate's
+/// or the truth's: posyaw: an RMS horizontal spread below min_spread_m, e.g.
+/// a hover, or an estimate drifting over a still truth; se3: positions that
+/// do not span a plane, second RMS singular value below min_spread_m),
 /// the rotation is taken from the orientations instead: M = Σ R̂_k R_gt,kᵀ
 /// replaces C (the same trace maximisation, as R·R̂_k ≈ R_gt,k), and the
 /// result says so (rotation_from_orientation). sim3 then is an error.

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <opencv2/core.hpp>
+
 #include "evio/core/error.h"
 #include "evio/estimator/frontend/log_image.h"
 #include "numeric_jacobian.h"
@@ -109,6 +111,38 @@ TEST(GradientTemplate, InterpolatesSamplesAndDerivativesExactlyOnQuadratics) {
     EXPECT_NEAR(dg(1, 0), 0.0, 1e-4);
     EXPECT_NEAR(dg(1, 1), 0.03 - 0.008 * p.y(), 1e-4);
   }
+}
+
+TEST(EkltCost, AvxTemplateLookupMatchesTheSse2OneBitForBit) {
+  // The bicubic lookup of the EKLT cost has an AVX path (two template rows
+  // per register) chosen at run time; it must give exactly the bits of the
+  // SSE2 path, or tracks (and every campaign result) would depend on the CPU.
+  if (!detail::ekltSampleHasAvx()) GTEST_SKIP() << "this CPU has no AVX: only the SSE2 path runs";
+  cv::Mat gx(80, 80, CV_32FC1), gy(80, 80, CV_32FC1);
+  cv::RNG rng(7);
+  rng.fill(gx, cv::RNG::UNIFORM, -3.0, 3.0);
+  rng.fill(gy, cv::RNG::NORMAL, 0.0, 1.5);
+  gx.at<float>(40, 40) = -0.0f;  // signed zeros and exact zeros go through the same sums
+  gy.at<float>(41, 40) = 0.0f;
+  GradientTemplate t;
+  t.assign(gx, gy, Vec2(40.3, 39.6), 30);
+  int compared = 0;
+  for (int k = 0; k < 2000; ++k) {
+    // Points whose 4×4 taps lie inside the crop (origin + [1, size − 3)).
+    const Vec2 W(t.originX() + 1.0 + rng.uniform(0.0, t.size() - 4.0),
+                 t.originY() + 1.0 + rng.uniform(0.0, t.size() - 4.0));
+    Vec2 g_sse, g_avx;
+    Mat2 dg_sse, dg_avx;
+    detail::ekltSampleInside(t, W, &g_sse, &dg_sse, false);
+    detail::ekltSampleInside(t, W, &g_avx, &dg_avx, true);
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_EQ(std::signbit(g_sse[i]), std::signbit(g_avx[i])) << k;
+      ASSERT_EQ(g_sse[i], g_avx[i]) << k;
+      for (int j = 0; j < 2; ++j) ASSERT_EQ(dg_sse(i, j), dg_avx(i, j)) << k << " " << i << j;
+    }
+    ++compared;
+  }
+  EXPECT_EQ(compared, 2000);
 }
 
 TEST(EkltCost, FeaturePositionInvertsTheWarp) {

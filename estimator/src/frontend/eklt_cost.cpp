@@ -2,6 +2,11 @@
 
 #include <cmath>
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define EVIO_EKLT_AVX 1  // an AVX path for the bicubic lookup, chosen at run time
+#endif
+
 namespace evio::estimator {
 
 namespace {
@@ -74,14 +79,84 @@ inline void sampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, 
   if (dg != nullptr) *dg << fdx[0], fdy[0], fdx[1], fdy[1];
 }
 
+#if defined(EVIO_EKLT_AVX)
+/// sampleInside with two template rows per 256-bit register (rows i and
+/// i + 1 side by side, each as its (gx, gy) pair): every lane sees the same
+/// double operations in the same order as sampleInside (products, then sums
+/// over the taps j, then over the rows i from 0 to 3; AVX without FMA), so
+/// the result is bit-identical to it.
+__attribute__((target("avx"))) void sampleInsideAvx(const GradientTemplate& templ, const Vec2& W, Vec2* g,
+                                                    Mat2* dg) {
+  const double cx = W.x() - templ.originX();
+  const double cy = W.y() - templ.originY();
+  const double fx = std::floor(cx);
+  const double fy = std::floor(cy);
+  double wx[4], dwx[4], wy[4], dwy[4];
+  catmullRomWeights(cx - fx, wx, dwx);
+  catmullRomWeights(cy - fy, wy, dwy);
+  const int n = templ.size();
+  const float* base = templ.data() + 2 * ((static_cast<int>(fy) - 1) * n + static_cast<int>(fx) - 1);
+  __m128d f = _mm_setzero_pd(), fdx = _mm_setzero_pd(), fdy = _mm_setzero_pd();
+  for (int pair = 0; pair < 2; ++pair) {
+    const float* row_a = base + 2 * (2 * pair) * n;
+    const float* row_b = row_a + 2 * n;
+    __m256d r = _mm256_setzero_pd(), d = _mm256_setzero_pd();
+    for (int j = 0; j < 4; ++j) {
+      // (gx, gy) of tap j on both rows, as doubles: [a.gx, a.gy, b.gx, b.gy].
+      const __m128 v4 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(row_a + 2 * j)),
+                                     reinterpret_cast<const __m64*>(row_b + 2 * j));
+      const __m256d v = _mm256_cvtps_pd(v4);
+      r = _mm256_add_pd(r, _mm256_mul_pd(_mm256_set1_pd(wx[j]), v));
+      d = _mm256_add_pd(d, _mm256_mul_pd(_mm256_set1_pd(dwx[j]), v));
+    }
+    const int i = 2 * pair;
+    const __m256d w = _mm256_setr_pd(wy[i], wy[i], wy[i + 1], wy[i + 1]);
+    const __m256d dw = _mm256_setr_pd(dwy[i], dwy[i], dwy[i + 1], dwy[i + 1]);
+    const __m256d pf = _mm256_mul_pd(w, r), pdx = _mm256_mul_pd(w, d), pdy = _mm256_mul_pd(dw, r);
+    // Row i, then row i + 1, as the scalar loop adds them.
+    f = _mm_add_pd(_mm_add_pd(f, _mm256_castpd256_pd128(pf)), _mm256_extractf128_pd(pf, 1));
+    fdx = _mm_add_pd(_mm_add_pd(fdx, _mm256_castpd256_pd128(pdx)), _mm256_extractf128_pd(pdx, 1));
+    fdy = _mm_add_pd(_mm_add_pd(fdy, _mm256_castpd256_pd128(pdy)), _mm256_extractf128_pd(pdy, 1));
+  }
+  alignas(16) double fv[2], fdxv[2], fdyv[2];
+  _mm_store_pd(fv, f);
+  _mm_store_pd(fdxv, fdx);
+  _mm_store_pd(fdyv, fdy);
+  *g = Vec2(fv[0], fv[1]);
+  if (dg != nullptr) *dg << fdxv[0], fdyv[0], fdxv[1], fdyv[1];
+}
+
+bool cpuHasAvx() {
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx") != 0;
+  }();
+  return has;
+}
+#else
+bool cpuHasAvx() { return false; }
+#endif
+
+/// sampleInside, through the AVX path when the CPU has it (the same bits).
+inline void sampleInsideFast(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg, bool avx) {
+#if defined(EVIO_EKLT_AVX)
+  if (avx) {
+    sampleInsideAvx(templ, W, g, dg);
+    return;
+  }
+#endif
+  (void)avx;
+  sampleInside(templ, W, g, dg);
+}
+
 inline PixelTerm pixelTerm(const GradientTemplate& templ, const WarpFrame& f, double ux, double uy,
-                           bool with_jacobian, bool inside) {
+                           bool with_jacobian, bool inside, bool avx = false) {
   // W = R u + t;   ∂W/∂θ = R' u = (−s ux − c uy, c ux − s uy).
   const Vec2 W(f.c * ux - f.s * uy + f.t.x(), f.s * ux + f.c * uy + f.t.y());
   Vec2 g;
   Mat2 dg;
   if (inside)
-    sampleInside(templ, W, &g, with_jacobian ? &dg : nullptr);
+    sampleInsideFast(templ, W, &g, with_jacobian ? &dg : nullptr, avx);
   else
     templ.sample(W, &g, with_jacobian ? &dg : nullptr);
   PixelTerm term{};
@@ -111,11 +186,19 @@ inline bool warpInside(const GradientTemplate& templ, const WarpFrame& f, int P)
 
 }  // namespace
 
+namespace detail {
+bool ekltSampleHasAvx() { return cpuHasAvx(); }
+void ekltSampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg, bool avx) {
+  sampleInsideFast(templ, W, g, dg, avx && cpuHasAvx());
+}
+}  // namespace detail
+
 bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out) {
   const int P = batch.patch_size;
   const double h = 0.5 * (P - 1);
   const WarpFrame frame(p);
   const bool inside = warpInside(*batch.templ, frame, P);
+  const bool avx = cpuHasAvx();
   double aa = 0.0, am = 0.0, abs_sum = 0.0;
   // Upper triangle of D = Σ ∂a/∂pᵀ ∂a/∂p, accumulated by hand (10 terms).
   double d00 = 0, d01 = 0, d02 = 0, d03 = 0, d11 = 0, d12 = 0, d13 = 0, d22 = 0, d23 = 0, d33 = 0;
@@ -125,7 +208,7 @@ bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, Ekl
     const double uy = i - h;
     const float* m_row = batch.measured + static_cast<std::ptrdiff_t>(i) * P;
     for (int j = 0; j < P; ++j) {
-      const PixelTerm t = pixelTerm(*batch.templ, frame, j - h, uy, with_jacobian, inside);
+      const PixelTerm t = pixelTerm(*batch.templ, frame, j - h, uy, with_jacobian, inside, avx);
       const double m = static_cast<double>(m_row[j]);
       aa += t.a * t.a;
       am += t.a * m;

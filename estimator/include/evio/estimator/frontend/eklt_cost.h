@@ -55,4 +55,13 @@ bool ekltResiduals(const EkltBatch& batch, const Vec4& p, VecX* r, MatX* d_r_d_p
 /// sends to the template point x0, c = c_acc + R(θ)ᵀ (x0 − t).
 Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const Vec2& x0);
 
+namespace detail {
+/// For tests: does this CPU take the AVX path of the bicubic template
+/// lookup, and the lookup itself (value g and ∂g/∂W at template point W,
+/// its 4×4 taps inside the template) through the AVX path (`avx` and the CPU
+/// has it) or the SSE2 one. Both must give the same bits.
+bool ekltSampleHasAvx();
+void ekltSampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg, bool avx);
+}  // namespace detail
+
 }  // namespace evio::estimator

@@ -62,34 +62,6 @@ std::string replaceAll(std::string s, const std::string& from, const std::string
   return s;
 }
 
-std::vector<std::string> expand(const Campaign& c, const CampaignStep& step,
-                                const std::map<std::string, std::string>& vars, const Job& job) {
-  std::vector<std::string> out;
-  const auto sets = [&](const Overrides& o) {
-    for (const auto& [k, v] : o) {
-      out.emplace_back("--set");
-      out.push_back(k + "=" + v);
-    }
-  };
-  for (const auto& arg : step.command) {
-    if (arg == "{simulate_set}") sets(job.simulate_set);
-    else if (arg == "{estimate_set}") sets(job.estimate_set);
-    else if (arg == "{evaluate_set}") sets(job.evaluate_set);
-    else if (arg == "{estimator_config}") {
-      if (!c.estimator_config.empty()) out.insert(out.end(), {"--config", c.estimator_config});
-    } else if (arg == "{method_option}") {
-      const bool sets_method = std::any_of(job.estimate_set.begin(), job.estimate_set.end(),
-                                           [](const auto& kv) { return kv.first == "method"; });
-      if (!sets_method) out.insert(out.end(), {"--method", c.methods[job.method].name});
-    } else {
-      std::string a = arg;
-      for (const auto& [k, v] : vars) a = replaceAll(a, "{" + k + "}", v);
-      out.push_back(a);
-    }
-  }
-  return out;
-}
-
 std::string cacheRoot(const Campaign& c, const std::string& results) {
   return c.cache.empty() ? (fs::path(results) / "sequences").string() : c.cache;
 }
@@ -185,7 +157,7 @@ std::string ensureSequence(const Campaign& c, const Job& job, const RunnerOption
   fs::remove_all(tmp);
   auto vars = vars_in;
   vars["sequence"] = tmp.string();
-  StepRecord rec{"simulate", expand(c, c.simulate, vars, job), "", 0.0};
+  StepRecord rec{"simulate", expandCommand(c, c.simulate, vars, job), "", 0.0};
   const ChildResult r = runChild(rec.command, staging.string(), (staging / "logs" / "simulate.log").string(),
                                  c.simulate.timeout_s);
   rec.result = r.describe();
@@ -267,7 +239,7 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
                                    std::pair<const char*, const CampaignStep*>{"evaluate", &c.evaluate_step}}) {
     if (!failed_step.empty()) break;
     const std::string log = (staging / "logs" / (std::string(name) + ".log")).string();
-    StepRecord rec{name, expand(c, *step, vars, job), "", 0.0};
+    StepRecord rec{name, expandCommand(c, *step, vars, job), "", 0.0};
     if (std::string(name) == "estimate") {
       // Only the evaluation changed since a finished job: re-score its estimate.
       const fs::path donor = estimateDonor(results, job, c.methods[job.method].name,
@@ -340,6 +312,35 @@ bool staleName(const std::string& name, const std::string& host) {
 }
 
 }  // namespace
+
+std::vector<std::string> expandCommand(const Campaign& c, const CampaignStep& step,
+                                       const std::map<std::string, std::string>& vars, const Job& job) {
+  std::vector<std::string> out;
+  const auto sets = [&](const Overrides& o) {
+    for (const auto& [k, v] : o) {
+      out.emplace_back("--set");
+      out.push_back(k + "=" + v);
+    }
+  };
+  for (const auto& arg : step.command) {
+    if (arg == "{simulate_set}") sets(job.simulate_set);
+    else if (arg == "{estimate_set}") sets(job.estimate_set);
+    else if (arg == "{evaluate_set}") sets(job.evaluate_set);
+    else if (arg == "{estimator_config}") {
+      if (!c.estimator_config.empty()) out.insert(out.end(), {"--config", c.estimator_config});
+    } else if (arg == "{method_option}") {
+      const bool sets_method = std::any_of(job.estimate_set.begin(), job.estimate_set.end(),
+                                           [](const auto& kv) { return kv.first == "method"; });
+      if (!sets_method) out.insert(out.end(), {"--method", c.methods[job.method].name});
+    } else {
+      std::string a = arg;
+      for (const auto& [k, v] : vars) a = replaceAll(a, "{" + k + "}", v);
+      out.push_back(a);
+    }
+  }
+  return out;
+}
+
 
 std::string hostName() {
   char buf[256] = {};

@@ -16,6 +16,7 @@
 #include "evio/core/io/config.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "evio/experiments/campaign.h"
+#include "evio/experiments/campaign_runner.h"
 #include "evio/simulator/scenario.h"
 
 namespace evio::experiments {
@@ -29,26 +30,10 @@ std::vector<std::string> asArguments(const Overrides& overrides) {
   return out;
 }
 
-/// The estimator configuration the estimate step passes: the campaign's
-/// estimator_config, or the value after "--config" in a custom command, or
-/// "" (the defaults).
-std::string estimatorConfig(const Campaign& c) {
-  if (!c.estimator_config.empty()) return c.estimator_config;
-  const auto& cmd = c.estimate.command;
-  const auto it = std::find(cmd.begin(), cmd.end(), "--config");
-  return it != cmd.end() && it + 1 != cmd.end() ? *(it + 1) : std::string();
-}
-
-/// The method name the estimate command passes as --method for this job:
-/// {method_option} passes it unless the job's settings set `method`; a
-/// literal {method} (a custom "--method {method}") always does; else none.
-std::string commandMethod(const Campaign& c, const Job& job) {
-  const auto& cmd = c.estimate.command;
-  const bool sets_method = std::any_of(job.estimate_set.begin(), job.estimate_set.end(),
-                                       [](const auto& kv) { return kv.first == "method"; });
-  const bool option = std::find(cmd.begin(), cmd.end(), "{method_option}") != cmd.end();
-  const bool literal = std::find(cmd.begin(), cmd.end(), "{method}") != cmd.end();
-  return literal || (option && !sets_method) ? c.methods[job.method].name : std::string();
+/// The value after `option` in an expanded command, or "".
+std::string optionValue(const std::vector<std::string>& command, const std::string& option) {
+  const auto it = std::find(command.begin(), command.end(), option);
+  return it != command.end() && it + 1 != command.end() ? *(it + 1) : std::string();
 }
 
 /// What `evio estimate [--config <config>] [--method <name>] --set …` does
@@ -77,8 +62,6 @@ TEST(ShippedCampaigns, EveryJobHasAValidScenarioAndEstimatorSettings) {
     ++campaigns;
     SCOPED_TRACE(entry.path().string());
     const Campaign c = loadCampaign(entry.path().string());
-    std::string config = estimatorConfig(c);
-    if (!config.empty() && fs::path(config).is_relative()) config = (root / config).string();  // a custom command's path
     std::set<std::string> scenarios_seen, settings_seen;
     for (const Job& job : expandJobs(c)) {
       const CampaignScenario& sc = c.scenarios[job.scenario];
@@ -92,8 +75,13 @@ TEST(ShippedCampaigns, EveryJobHasAValidScenarioAndEstimatorSettings) {
           ADD_FAILURE() << job.id << ": " << e.what();
         }
       }
-      const std::string command_method = commandMethod(c, job);
-      if (settings_seen.insert(command_method + "|" + overridesText(job.estimate_set)).second) {
+      // The estimate step's own command line, as the runner expands it.
+      const std::vector<std::string> command =
+          expandCommand(c, c.estimate, {{"method", c.methods[job.method].name}}, job);
+      std::string config = optionValue(command, "--config");
+      if (!config.empty() && fs::path(config).is_relative()) config = (root / config).string();  // run from the repository
+      const std::string command_method = optionValue(command, "--method");
+      if (settings_seen.insert(config + "|" + command_method + "|" + overridesText(job.estimate_set)).second) {
         try {
           checkEstimatorSettings(config, job.estimate_set, command_method);
         } catch (const std::exception& e) {

@@ -50,16 +50,33 @@ inline void catmullRomWeights(double t, double w[4], double dw[4]) {
 
 /// Bicubic sample of the interleaved template with derivatives, for points
 /// whose 4×4 taps lie inside the crop (checked by the caller).
-inline void sampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg) {
+/// The 4×4 taps of a bicubic lookup at template point W: Catmull-Rom weights
+/// (and their derivatives) along x and y, and the interleaved (gx, gy) of the
+/// top-left tap; rows are 2·n floats apart.
+struct BicubicTaps {
+  double wx[4], dwx[4], wy[4], dwy[4];
+  const float* base;
+  int n;
+};
+
+inline BicubicTaps bicubicTaps(const GradientTemplate& templ, const Vec2& W) {
+  BicubicTaps t;
   const double cx = W.x() - templ.originX();
   const double cy = W.y() - templ.originY();
   const double fx = std::floor(cx);
   const double fy = std::floor(cy);
-  double wx[4], dwx[4], wy[4], dwy[4];
-  catmullRomWeights(cx - fx, wx, dwx);
-  catmullRomWeights(cy - fy, wy, dwy);
-  const int n = templ.size();
-  const float* base = templ.data() + 2 * ((static_cast<int>(fy) - 1) * n + static_cast<int>(fx) - 1);
+  catmullRomWeights(cx - fx, t.wx, t.dwx);
+  catmullRomWeights(cy - fy, t.wy, t.dwy);
+  t.n = templ.size();
+  t.base = templ.data() + 2 * ((static_cast<int>(fy) - 1) * t.n + static_cast<int>(fx) - 1);
+  return t;
+}
+
+inline void sampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg) {
+  const BicubicTaps t = bicubicTaps(templ, W);
+  const double *wx = t.wx, *dwx = t.dwx, *wy = t.wy, *dwy = t.dwy;
+  const float* base = t.base;
+  const int n = t.n;
   // Both channels (gx, gy) at once as 2-vectors: value, ∂/∂x, ∂/∂y.
   using A2 = Eigen::Array2d;
   A2 f = A2::Zero(), fdx = A2::Zero(), fdy = A2::Zero();
@@ -87,15 +104,10 @@ inline void sampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, 
 /// the result is bit-identical to it.
 __attribute__((target("avx"))) void sampleInsideAvx(const GradientTemplate& templ, const Vec2& W, Vec2* g,
                                                     Mat2* dg) {
-  const double cx = W.x() - templ.originX();
-  const double cy = W.y() - templ.originY();
-  const double fx = std::floor(cx);
-  const double fy = std::floor(cy);
-  double wx[4], dwx[4], wy[4], dwy[4];
-  catmullRomWeights(cx - fx, wx, dwx);
-  catmullRomWeights(cy - fy, wy, dwy);
-  const int n = templ.size();
-  const float* base = templ.data() + 2 * ((static_cast<int>(fy) - 1) * n + static_cast<int>(fx) - 1);
+  const BicubicTaps t = bicubicTaps(templ, W);
+  const double *wx = t.wx, *dwx = t.dwx, *wy = t.wy, *dwy = t.dwy;
+  const float* base = t.base;
+  const int n = t.n;
   __m128d f = _mm_setzero_pd(), fdx = _mm_setzero_pd(), fdy = _mm_setzero_pd();
   for (int pair = 0; pair < 2; ++pair) {
     const float* row_a = base + 2 * (2 * pair) * n;

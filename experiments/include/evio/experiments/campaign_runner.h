@@ -23,12 +23,20 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "evio/experiments/campaign.h"
 
 namespace evio::experiments {
+
+/// A step's command for one job: placeholders replaced from `vars` ({name}
+/// → vars["name"]; unknown names stay as written) and the whole-argument
+/// placeholders of campaign.h expanded ({simulate_set}, {estimate_set},
+/// {evaluate_set}, {estimator_config}, {method_option}).
+std::vector<std::string> expandCommand(const Campaign& c, const CampaignStep& step,
+                                       const std::map<std::string, std::string>& vars, const Job& job);
 
 struct RunnerOptions {
   std::string results;         ///< results folder (created)

@@ -11,6 +11,7 @@
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/images_txt.h"
 #include "evio/core/io/imu_txt.h"
+#include "evio/core/io/range_txt.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/pipeline/estimate_writer.h"
 #include "evio/estimator/pipeline/groundtruth_init.h"
@@ -268,11 +269,16 @@ TEST(SequenceReader, MergesStreamsInTimeOrderOnTheCameraClock) {
   frames.append(5 * kNsPerMs, cv::Mat(4, 6, CV_8UC1, cv::Scalar(7)));
   frames.append(15 * kNsPerMs, cv::Mat(4, 6, CV_8UC1, cv::Scalar(7)));
   frames.close();
+  // Range readings at 5 ms (with the frame: after it), 12 ms (no return) and 26 ms (after the events).
+  io::writeRangeText(dir.file("range.txt"), {{5 * kNsPerMs, 7.5, true}, {12 * kNsPerMs, 0.0, false},
+                                             {26 * kNsPerMs, 8.25, true}});
 
-  const auto run = [&](TimeNs offset) {
+  std::vector<io::RangeSample> ranges;
+  const auto run = [&](TimeNs offset, bool read_range = false) {
     SequenceReaderOptions o;
     o.max_events_per_chunk = 3;
     o.time_offset_cam_imu_ns = offset;
+    o.read_range = read_range;
     SequenceReader reader(folder, o);
     std::string order;
     SequenceItem item;
@@ -288,6 +294,10 @@ TEST(SequenceReader, MergesStreamsInTimeOrderOnTheCameraClock) {
         if (item.kind == SequenceItem::Kind::kFrame) {
           EXPECT_EQ(reader.loadFrame(item.frame_index).cols, 6);
           order += 'F';
+        } else if (item.kind == SequenceItem::Kind::kRange) {
+          EXPECT_EQ(item.t_ns, item.range.t_ns);
+          ranges.push_back(item.range);
+          order += 'R';
         } else {
           order += 'I';
         }
@@ -302,6 +312,12 @@ TEST(SequenceReader, MergesStreamsInTimeOrderOnTheCameraClock) {
   EXPECT_EQ(run(0), "IeeFeeIeeFeeIee");
   // With t_imu = t_cam + 2 ms the IMU samples sit at −2, 8 and 18 ms of the camera clock.
   EXPECT_EQ(run(2 * kNsPerMs), "IeeFeIeeeFeIeee");
+  // range.txt on the camera clock: 1-4 | F(5) R(5) | 5-9 | I(10) | 10-11 | R(12) | 12-14 | F(15) | … | R(26).
+  EXPECT_EQ(run(0, true), "IeeFReeIeReFeeIeeR");
+  ASSERT_EQ(ranges.size(), 3u);
+  EXPECT_EQ(ranges[0], (io::RangeSample{5 * kNsPerMs, 7.5, true}));
+  EXPECT_FALSE(ranges[1].valid);
+  EXPECT_EQ(ranges[2], (io::RangeSample{26 * kNsPerMs, 8.25, true}));
 }
 
 TEST(SequenceReader, MissingStreamsAreErrors) {
@@ -316,6 +332,13 @@ TEST(SequenceReader, MissingStreamsAreErrors) {
   SequenceItem item;
   EXPECT_FALSE(reader.next(item));
   EXPECT_THROW(SequenceReader(dir.file("nope"), o), Error);
+  o.read_range = true;
+  try {
+    SequenceReader no_range(dir.path().string(), o);
+    FAIL() << "a missing range.txt was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("range.txt"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

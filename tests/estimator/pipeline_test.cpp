@@ -12,6 +12,8 @@
 #include "evio/core/io/config.h"
 #include "evio/core/io/events_h5.h"
 #include "evio/core/io/imu_state_txt.h"
+#include "evio/core/io/range_txt.h"
+#include "evio/core/io/sensors_yaml.h"
 #include "evio/core/io/status_yaml.h"
 #include "evio/core/io/timing_txt.h"
 #include "evio/core/io/tum.h"
@@ -283,6 +285,36 @@ TEST(PipelineBadInput, InitialisationNeedsGroundTruthOrStaticMode) {
   EXPECT_EQ(r.status.code, io::EstimateStatus::Code::kFailed);
   EXPECT_NE(r.status.cause.find("never initialised"), std::string::npos) << r.status.cause;
   EXPECT_EQ(r.poses, 0u);
+}
+
+TEST(Pipeline, UseRangeFeedsEveryValidRangeReadingToTheBackend) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 2.0;
+  writeTinySequence(seq, so);
+  PipelineOptions o = tracksOptions();
+  o.backend.use_range = true;
+  // The rig has no range finder: one error naming the option, and no output.
+  expectErrorContaining([&] { runPipeline(seq, o, dir.file("out")); }, {"backend.use_range", "no range finder"});
+  EXPECT_FALSE(fs::exists(dir.file("out")));
+  SensorRig rig = io::readSensorsYaml(seq + "/sensors.yaml");
+  rig.range_finder = RangeFinderSensor{Pose(), 0.1, 50.0, 0.02};
+  io::writeSensorsYaml(seq + "/sensors.yaml", rig);
+  // 20 Hz readings over the run, every fourth without a return.
+  std::vector<io::RangeSample> ranges;
+  int valid = 0;
+  for (int k = 1; k < 40; ++k) {
+    ranges.push_back(io::RangeSample{secondsToNs(0.05 * k), k % 4 == 0 ? 0.0 : 3.0, k % 4 != 0});
+    valid += k % 4 != 0;
+  }
+  io::writeRangeText(seq + "/range.txt", ranges);
+  const PipelineResult r = runPipeline(seq, o, dir.file("out"));
+  // Each valid reading is either an update or rejected (the tiny scene is no plane under the beam).
+  EXPECT_EQ(r.backend.range_updates + r.backend.range_rejected, valid);
+  o.backend.use_range = false;
+  const PipelineResult off = runPipeline(seq, o, dir.file("off"));
+  EXPECT_EQ(off.backend.range_updates + off.backend.range_rejected, 0);
 }
 
 TEST(PipelineBadInput, MissingFolderOrCalibrationIsAnError) {

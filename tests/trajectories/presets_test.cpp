@@ -7,6 +7,8 @@
 #include <numbers>
 
 #include "evio/core/so3.h"
+#include "evio/core/error.h"
+#include "evio/trajectories/flight.h"
 #include "evio/trajectories/hover.h"
 #include "evio/trajectories/trajectory_factory.h"
 #include "trajectory_presets.h"
@@ -219,6 +221,31 @@ TEST(Presets, FlightTakesOffTraversesAndLandsAtRest) {
   EXPECT_NEAR(max_z, 10.0, 1e-9);
   EXPECT_GT(max_tilt * kRadToDeg, 5.0);   // it leans into the traverse
   EXPECT_LT(max_tilt * kRadToDeg, 30.0);
+}
+
+TEST(Presets, FlightKeepsTheThrustUpAndRefusesAClimbThatWouldNeedDownwardThrust) {
+  // Mars gravity 3.721 m/s²: 10 m in 7 s peaks at 10·9.841/49 = 2.0 m/s², so
+  // the body's z axis (thrust) stays within 90° of up all through the climb.
+  FlightOptions o;
+  o.duration_s = 30, o.ground_time_s = 1, o.climb_s = 7, o.hover_before_traverse_s = 2, o.traverse_s = 12,
+  o.descent_s = 6, o.altitude_m = 10, o.traverse_distance_m = 30;
+  const FlightTrajectory ok(o);
+  for (TimeNs t = ok.startTime(); t <= ok.endTime(); t += 5 * kNsPerMs)
+    ASSERT_GT(ok.evaluate(t).T_W_B.rotation()(2, 2), 0.5) << nsToSeconds(t);
+  // 10 m in 5 s peaks at 3.94 m/s² > g: the thrust-aligned attitude would flip
+  // upside down in mid-climb (what the mars campaign's first compression did).
+  o.climb_s = 5;
+  try {
+    FlightTrajectory bad(o);
+    FAIL() << "a 5-s climb of 10 m under Mars gravity was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("climb_s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pull down"), std::string::npos) << e.what();
+  }
+  o.climb_s = 7, o.descent_s = 5;
+  EXPECT_THROW(FlightTrajectory{o}, Error);
+  o.descent_s = 6, o.gravity_mps2 = 9.81, o.climb_s = 3.2;  // Earth: 10·9.841/3.2² = 9.61 < 9.81
+  EXPECT_NO_THROW(FlightTrajectory{o});
 }
 
 TEST(Presets, LavaTubeEntryGoesFromOutsideToInside) {

@@ -67,6 +67,20 @@ TEST(Taylor, SmoothStepIsFlatAtItsEndsAndExactInside) {
   EXPECT_EQ(motion::smoothStep(taylor::variable<4>(1e-5)).derivative(1), 0.0);
 }
 
+TEST(Taylor, SmoothStepPeakSecondDerivativeIsTheStatedConstant) {
+  // The exact series' S'' on a 1e-5 grid: its maximum is the constant (found
+  // to 40 digits with mpmath), at u ≈ 0.21826, and −S'' mirrors it at 1 − u.
+  double peak = 0.0, at = 0.0;
+  for (int i = 1; i < 100000; ++i) {
+    const double u = i * 1e-5;
+    const double s2 = motion::smoothStep(taylor::variable<2>(u)).derivative(2);
+    if (std::abs(s2) > peak) peak = std::abs(s2), at = u;
+  }
+  EXPECT_LE(peak, motion::kSmoothStepPeakSecondDerivative * (1 + 1e-12));
+  EXPECT_NEAR(peak, motion::kSmoothStepPeakSecondDerivative, 1e-7);  // grid within 1e-5 of the peak: ΔS'' ~ S''''·Δu²/2
+  EXPECT_TRUE(std::abs(at - 0.21826) < 2e-5 || std::abs(at - (1 - 0.21826)) < 2e-5) << at;
+}
+
 TEST(Taylor, EulerRatesGiveTheKnownBodyAngularVelocity) {
   // For R = Rz(ψ) Ry(θ) Rx(φ):
   //   ω_B = [φ̇ − ψ̇ sin θ,  θ̇ cos φ + ψ̇ cos θ sin φ,  −θ̇ sin φ + ψ̇ cos θ cos φ].

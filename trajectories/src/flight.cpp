@@ -23,6 +23,8 @@ void FlightOptions::validate() const {
   requireField(finalHoverSeconds() >= 0.0, "duration_s",
                "must be at least the sum of the phases (" +
                    std::to_string(duration_s - finalHoverSeconds()) + " s)");
+  preset::requireUpwardThrust("climb_s", altitude_m, climb_s, gravity_mps2);
+  preset::requireUpwardThrust("descent_s", altitude_m, descent_s, gravity_mps2);
   preset::requireNonNegative3("wobble_amplitude_deg", wobble_amplitude_deg);
   requireInRange("wobble_amplitude_deg[1]", wobble_amplitude_deg(1), 0.0, 30.0);
   preset::requireBand("wobble_min_frequency_hz", wobble_min_frequency_hz, "wobble_max_frequency_hz",

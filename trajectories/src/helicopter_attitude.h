@@ -10,9 +10,28 @@
 /// ω_B needs the jerk and α_B the snap, so the path is a series of order 4
 /// and the attitude one of order 2.
 
+#include <cmath>
+#include <string>
+
+#include "evio/core/options.h"
+#include "evio/trajectories/motion_primitives.h"
 #include "evio/trajectories/taylor.h"
 
 namespace evio::preset {
+
+/// Rotors push, never pull: a vertical smoothstep move of `height_m` over
+/// `duration_s` must keep its peak acceleration |height|·S''max/T² below
+/// gravity, or the thrust a_W + g e_z would point down and the
+/// thrust-aligned attitude would flip upside down. Names `field` otherwise.
+inline void requireUpwardThrust(const std::string& field, double height_m, double duration_s, double gravity_mps2) {
+  const double peak = std::abs(height_m) * motion::kSmoothStepPeakSecondDerivative / (duration_s * duration_s);
+  const double shortest = std::sqrt(std::abs(height_m) * motion::kSmoothStepPeakSecondDerivative / gravity_mps2);
+  requireField(peak < gravity_mps2, field,
+               "a vertical move of " + std::to_string(std::abs(height_m)) + " m in " + std::to_string(duration_s) +
+                   " s peaks at " + std::to_string(peak) + " m/s^2, not below gravity (" +
+                   std::to_string(gravity_mps2) + " m/s^2): the rotors would have to pull down; make it longer than " +
+                   std::to_string(shortest) + " s");
+}
 
 /// R_W_B of order 2 from the acceleration series a_W (order 2: a, jerk/1!, snap/2!).
 inline taylor::Matrix3<2> thrustAlignedAttitude(const taylor::Vector3<2>& a_W, double gravity_mps2,

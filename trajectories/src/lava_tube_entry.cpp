@@ -19,6 +19,7 @@ void LavaTubeEntryOptions::validate() const {
   requireField(descent_s <= entry_s, "descent_s", "must not exceed entry_s");
   requireField(hover_start_s + entry_s <= duration_s, "duration_s",
                "must be at least hover_start_s + entry_s");
+  preset::requireUpwardThrust("descent_s", inside_altitude_m - start_altitude_m, descent_s, gravity_mps2);
   preset::requireNonNegative3("wobble_amplitude_deg", wobble_amplitude_deg);
   requireInRange("wobble_amplitude_deg[1]", wobble_amplitude_deg(1), 0.0, 30.0);
   preset::requireBand("wobble_min_frequency_hz", wobble_min_frequency_hz, "wobble_max_frequency_hz",

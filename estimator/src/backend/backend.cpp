@@ -298,6 +298,12 @@ void Backend::processRange(double range_m) {
     ++stats_.range_rejected;
     return;
   }
+  {
+    // Beam hit point h = o + range · d, o = p_W_B + R_W_B p_B_L, d = R_W_B R_B_L e_z.
+    const Mat3 R = state_.imu.q_W_B.toRotationMatrix();
+    const Vec3 o = state_.imu.p_W_B + R * rf.T_B_L.translation();
+    range_hit_ = std::pair{state_.imu.t_ns, Vec3(o + range_m * (R * rf.T_B_L.rotation().col(2)))};
+  }
   Eigen::Matrix<double, 1, Eigen::Dynamic> H1;
   double r = 0.0;
   if (!rangeResidual(state_, rf.T_B_L, range_m, options_.range_max_feature_angle_deg * kDeg, &H1, &r)) {

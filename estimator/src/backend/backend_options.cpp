@@ -40,6 +40,8 @@ void BackendOptions::validate() const {
   requireNonNegative("max_late_s", max_late_s);
   requirePositive("max_velocity_mps", max_velocity_mps);
   requireNonNegative("range_sigma_m", range_sigma_m);
+  requireNonNegative("range_prior_relative_sigma", range_prior_relative_sigma);
+  requireNonNegative("range_prior_max_age_s", range_prior_max_age_s);
   requireInRange("range_max_feature_angle_deg", range_max_feature_angle_deg, 0.0, 90.0);
   requirePositive("zero_velocity_sigma_mps", zero_velocity_sigma_mps);
   requirePositive("static_window_s", static_window_s);

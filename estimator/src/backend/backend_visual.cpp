@@ -202,6 +202,19 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
   estimates_.push_back(makeEstimate());
 }
 
+std::optional<double> Backend::rangeDepthPrior(const CameraClone& clone, const Vec2& z) const {
+  if (!options_.use_range || !(options_.range_prior_relative_sigma > 0.0) || !range_hit_) return std::nullopt;
+  if (nsToSeconds(clone.t_ns - range_hit_->first) > options_.range_prior_max_age_s) return std::nullopt;
+  // The ray c + s R_W_C (α, β, 1) meets the level plane through the hit point h
+  // at s = (h_z − c_z) / (R_W_C (α, β, 1))_z; s is the depth along the
+  // camera's z axis, so ρ0 = 1/s.
+  const Vec3 u = clone.R_W_C() * Vec3(z.x(), z.y(), 1.0);
+  if (!(u.z() < -0.1 * u.norm())) return std::nullopt;  // within about 6° of the horizon or above it
+  const double s = (range_hit_->second.z() - clone.p_W_C.z()) / u.z();
+  if (!(s >= options_.triangulation_min_depth_m) || !std::isfinite(s)) return std::nullopt;
+  return 1.0 / s;
+}
+
 void Backend::initializeSlamFeatures(const std::vector<FeatureId>& candidates) {
   const std::size_t c = state_.clones.size() - 1;
   const double sigma2 = sigma_z_ * sigma_z_;
@@ -239,8 +252,13 @@ void Backend::initializeSlamFeatures(const std::vector<FeatureId>& candidates) {
         if (done) ++stats_.slam_initialized_triangulated;
       }
     }
-    if (!done) {
-      addSlamFeatureWithPrior(state_, id, c, track.observations.back().z, rho0, sigma_rho0, sigma_z_);
+    if (done) continue;
+    const Vec2& z = track.observations.back().z;
+    if (const auto rho = rangeDepthPrior(state_.clones[c], z)) {
+      addSlamFeatureWithPrior(state_, id, c, z, *rho, options_.range_prior_relative_sigma * *rho, sigma_z_);
+      ++stats_.slam_initialized_range;
+    } else {
+      addSlamFeatureWithPrior(state_, id, c, z, rho0, sigma_rho0, sigma_z_);
       ++stats_.slam_initialized_prior;
     }
   }

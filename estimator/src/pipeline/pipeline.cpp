@@ -74,6 +74,7 @@ class PipelineRun {
   void loop();
   void finish();
   void onImu(const SequenceItem& item);
+  void onRange(const SequenceItem& item);
   void onEvents(const SequenceItem& item);
   void onFrame(const SequenceItem& item);
   void collectTracks();
@@ -169,6 +170,9 @@ void PipelineRun::setup() {
   ro.read_events = eklt_;
   ro.read_frames = (eklt_ || klt_) && !images.empty();
   ro.read_imu = true;
+  ro.read_range = options_.backend.use_range;
+  if (options_.backend.use_range && !rig_.rig.range_finder)
+    throw Error("backend.use_range: " + rig_.source + " of " + sequence_ + " has no range finder");
   ro.event_width = event_cam.camera.width();
   ro.event_height = event_cam.camera.height();
   ro.calibration = rig_.describe(event_cam);
@@ -269,6 +273,12 @@ void PipelineRun::onImu(const SequenceItem& item) {
   }
 }
 
+void PipelineRun::onRange(const SequenceItem& item) {
+  if (!item.range.valid) return;  // no return: nothing measured
+  StageTimer timer(&result_.times.backend_s);
+  backend_->addRange(item.t_ns, item.range.range_m);
+}
+
 void PipelineRun::onEvents(const SequenceItem& item) {
   StageTimer timer(&result_.times.frontend_s);
   const std::uint64_t kept_before = frontend_->numEventsKept();
@@ -347,6 +357,7 @@ void PipelineRun::loop() {
       case SequenceItem::Kind::kImu: onImu(item); break;
       case SequenceItem::Kind::kEvents: onEvents(item); break;
       case SequenceItem::Kind::kFrame: onFrame(item); break;
+      case SequenceItem::Kind::kRange: onRange(item); break;
     }
     afterItem(t_now_);
     const bool stopped = !backend_->status().ok() || pipeline_failure_.has_value();

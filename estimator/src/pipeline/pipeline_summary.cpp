@@ -58,9 +58,12 @@ std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions
   count("msckf_triangulation_failed", b.msckf_triangulation_failed);
   count("slam_initialized_triangulated", b.slam_initialized_triangulated);
   count("slam_initialized_prior", b.slam_initialized_prior);
+  count("slam_initialized_range", b.slam_initialized_range);
   count("slam_updates_rejected", b.slam_updates_rejected);
   count("slam_features_removed", b.slam_features_removed);
   count("slam_reanchored", b.slam_reanchored);
+  count("range_updates", b.range_updates);
+  count("range_rejected", b.range_rejected);
   out << YAML::EndMap;
   out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
   for (const auto& n : r.notes) out << n;

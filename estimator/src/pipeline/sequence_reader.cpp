@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <utility>
 
 #include "evio/core/error.h"
 #include "evio/core/io/events_h5.h"
@@ -104,6 +105,15 @@ struct SequenceReader::ImuStream {
   bool have = false;
 };
 
+/// range.txt, one reading looked ahead.
+struct SequenceReader::RangeStream {
+  explicit RangeStream(const std::string& path) : reader(path) { have = reader.next(sample); }
+  void advance() { have = reader.next(sample); }
+  io::RangeReader reader;
+  io::RangeSample sample;
+  bool have = false;
+};
+
 SequenceReader::SequenceReader(std::string folder, const SequenceReaderOptions& options)
     : folder_(std::move(folder)), options_(options) {
   if (!fs::is_directory(folder_)) throw Error(folder_ + ": not a folder");
@@ -122,6 +132,11 @@ SequenceReader::SequenceReader(std::string folder, const SequenceReaderOptions& 
     if (!fs::exists(imu)) throw Error(folder_ + ": no imu.txt");
     imu_ = std::make_unique<ImuStream>(imu.string());
   }
+  if (options_.read_range) {
+    const fs::path range = fs::path(folder_) / "range.txt";
+    if (!fs::exists(range)) throw Error(folder_ + ": no range.txt");
+    range_ = std::make_unique<RangeStream>(range.string());
+  }
 }
 
 SequenceReader::~SequenceReader() = default;
@@ -139,25 +154,35 @@ bool SequenceReader::nextEvents(SequenceItem& item, std::optional<TimeNs> t_end)
 bool SequenceReader::next(SequenceItem& item) {
   const bool have_imu = imu_ && imu_->have;
   const bool have_frame = next_frame_ < frames_.size();
+  const bool have_range = range_ && range_->have;
+  const TimeNs t_imu = have_imu ? imu_->sample.t_ns - options_.time_offset_cam_imu_ns : 0;
+  const TimeNs t_frame = have_frame ? frames_[next_frame_].t_ns : 0;
+  const TimeNs t_range = have_range ? range_->sample.t_ns : 0;
   std::optional<TimeNs> t_stop;
-  if (have_imu) t_stop = imu_->sample.t_ns - options_.time_offset_cam_imu_ns;
-  if (have_frame) t_stop = std::min(t_stop.value_or(frames_[next_frame_].t_ns), frames_[next_frame_].t_ns);
+  for (const auto& [have, t] : {std::pair{have_imu, t_imu}, {have_frame, t_frame}, {have_range, t_range}})
+    if (have) t_stop = std::min(t_stop.value_or(t), t);
   bool got = false;
   if (nextEvents(item, t_stop)) {
     got = true;
-  } else if (have_imu && (!have_frame || imu_->sample.t_ns - options_.time_offset_cam_imu_ns <= frames_[next_frame_].t_ns)) {
+  } else if (have_imu && t_imu == *t_stop) {
     item.kind = SequenceItem::Kind::kImu;
     item.imu = imu_->sample;
-    item.t_ns = imu_->sample.t_ns - options_.time_offset_cam_imu_ns;
+    item.t_ns = t_imu;
     imu_->advance();
     if (imu_->have && imu_->sample.t_ns <= item.imu.t_ns)  // the reader checks too; be explicit
       throw Error(folder_ + "/imu.txt: time does not increase after " + std::to_string(nsToSeconds(item.imu.t_ns)) + " s");
     got = true;
-  } else if (have_frame) {
+  } else if (have_frame && t_frame == *t_stop) {
     item.kind = SequenceItem::Kind::kFrame;
     item.frame_index = next_frame_;
-    item.t_ns = frames_[next_frame_].t_ns;
+    item.t_ns = t_frame;
     ++next_frame_;
+    got = true;
+  } else if (have_range) {
+    item.kind = SequenceItem::Kind::kRange;
+    item.range = range_->sample;
+    item.t_ns = t_range;
+    range_->advance();
     got = true;
   }
   if (!got) return false;

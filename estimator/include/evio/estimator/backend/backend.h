@@ -34,6 +34,7 @@
 /// evio::Error (bad input, not a filter state).
 
 #include <cstdint>
+#include <optional>
 #include <deque>
 #include <limits>
 #include <map>
@@ -112,6 +113,10 @@ class Backend {
   void augmentClone();
   void slideWindow();
   void initializeSlamFeatures(const std::vector<FeatureId>& candidates);
+  /// ρ0 of a feature seen at normalised z from `clone`, from the latest range
+  /// reading (BackendOptions::range_prior_relative_sigma); nullopt when there
+  /// is none or the ray does not meet the level plane in front of the camera.
+  std::optional<double> rangeDepthPrior(const CameraClone& clone, const Vec2& z) const;
 
   void processRange(double range_m);
   void processZeroVelocity();
@@ -150,6 +155,8 @@ class Backend {
   std::map<std::pair<TimeNs, std::uint64_t>, Item> pending_;
   TimeNs last_set_t_ = std::numeric_limits<TimeNs>::min();
   TimeNs last_range_t_ = std::numeric_limits<TimeNs>::min();
+  /// The latest range reading's beam hit point in W and its filter time.
+  std::optional<std::pair<TimeNs, Vec3>> range_hit_;
   TimeNs last_zero_velocity_t_ = std::numeric_limits<TimeNs>::min();
   std::uint64_t next_seq_ = 0;
   std::map<FeatureId, FeatureTrack> tracks_;

@@ -94,6 +94,18 @@ struct BackendOptions {
   double max_velocity_mps = 100.0;  ///< a faster velocity estimate means divergence, m/s
 
   // Optional updates -------------------------------------------------------------------
+  /// Feed the sequence's range.txt to the range update (xVIO's range-VIO:
+  /// the laser range finder fixes the scale of the SLAM features near its
+  /// beam). Needs a range finder in sensors.yaml.
+  bool use_range = false;
+  /// With use_range, a SLAM feature that cannot be triangulated takes its
+  /// depth prior from the latest range reading instead of slam_min_depth_m:
+  /// its ray meets the level plane (normal along W's z) through the beam's
+  /// hit point, ρ0 = 1/depth, σ_ρ0 = range_prior_relative_sigma · ρ0
+  /// (terrain relief about the plane). 0 keeps the fixed prior.
+  double range_prior_relative_sigma = 0.3;
+  /// A reading older than this does not give priors, s.
+  double range_prior_max_age_s = 0.25;
   /// Range-finder noise σ, m (0: the rig's noise_sigma_m).
   double range_sigma_m = 0.0;
   /// SLAM features whose ray is within this angle of the range beam define
@@ -143,6 +155,9 @@ struct BackendOptions {
     v("max_delay_s", max_delay_s, "filter lag behind the newest IMU reading, s");
     v("max_late_s", max_late_s, "late measurements applied at the filter state, s");
     v("max_velocity_mps", max_velocity_mps, "velocity bound for divergence, m/s");
+    v("use_range", use_range, "use the laser range finder (range.txt)");
+    v("range_prior_relative_sigma", range_prior_relative_sigma, "relative sigma of the range depth prior (0: off)");
+    v("range_prior_max_age_s", range_prior_max_age_s, "oldest range reading for a depth prior, s");
     v("range_sigma_m", range_sigma_m, "range noise, m (0: rig)");
     v("range_max_feature_angle_deg", range_max_feature_angle_deg, "features near the beam, deg");
     v("zero_velocity_sigma_mps", zero_velocity_sigma_mps, "zero-velocity noise, m/s");

@@ -57,6 +57,7 @@ struct BackendStats {
   std::int64_t msckf_triangulation_failed = 0;
   std::int64_t slam_initialized_triangulated = 0;
   std::int64_t slam_initialized_prior = 0;
+  std::int64_t slam_initialized_range = 0;    ///< depth prior from the range finder
   std::int64_t slam_updates_rejected = 0;     ///< Mahalanobis gate
   std::int64_t slam_features_removed = 0;     ///< lost, gated out or invalid
   std::int64_t slam_reanchored = 0;

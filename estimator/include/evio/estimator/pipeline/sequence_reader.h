@@ -2,14 +2,16 @@
 /// @file sequence_reader.h
 /// Streams a sequence folder (DESIGN.md layout) in time order: event chunks
 /// (events.h5 when present, else events.txt), frames (images.txt, loaded on
-/// demand) and IMU samples (imu.txt), merged on the camera clock. Memory
+/// demand), IMU samples (imu.txt) and, when asked for, laser range-finder
+/// readings (range.txt, camera clock), merged on the camera clock. Memory
 /// stays flat: events come in chunks of at most max_events_per_chunk, the IMU
-/// one sample at a time, frames as stamps until loaded.
+/// and the range finder one sample at a time, frames as stamps until loaded.
 ///
 /// Order: an IMU sample stamped t_imu is placed at camera time
 /// t = t_imu − time_offset_cam_imu (sensors.yaml: t_imu = t_cam + offset).
 /// Before the IMU sample or frame at time T come all events with t < T; at
-/// equal times the IMU sample comes before the frame.
+/// equal times the IMU sample comes before the frame, and the frame before the
+/// range reading.
 ///
 /// Bad input is evio::Error: decreasing event times (from the readers, naming
 /// the file and index or line), events outside the sensor size given, a
@@ -28,6 +30,7 @@
 #include "evio/core/event.h"
 #include "evio/core/imu_sample.h"
 #include "evio/core/io/images_txt.h"
+#include "evio/core/io/range_txt.h"
 #include "evio/core/time.h"
 
 namespace evio::estimator {
@@ -36,6 +39,7 @@ struct SequenceReaderOptions {
   bool read_events = true;
   bool read_frames = true;
   bool read_imu = true;
+  bool read_range = false;  ///< range.txt (an error when missing)
   std::size_t max_events_per_chunk = std::size_t{1} << 14;
   /// Event sensor size to check events against (0: unchecked); `calibration`
   /// names where it came from in messages ("sensors.yaml camera cam0").
@@ -47,19 +51,20 @@ struct SequenceReaderOptions {
 };
 
 struct SequenceItem {
-  enum class Kind { kEvents, kFrame, kImu };
+  enum class Kind { kEvents, kFrame, kImu, kRange };
   Kind kind = Kind::kEvents;
   TimeNs t_ns = 0;            ///< camera clock: last event of the chunk, frame time, IMU time − offset
   EventArray events;          ///< kEvents: the chunk (non-empty, time-ordered)
   std::size_t frame_index = 0;  ///< kFrame: index into frames()
   ImuSample imu;              ///< kImu: the sample as read (IMU clock)
+  io::RangeSample range;      ///< kRange: the reading as read (camera clock)
 };
 
 class SequenceReader {
  public:
   /// Opens the streams that are asked for and exist. Throws evio::Error when
   /// the folder does not exist, events are asked for and neither events.h5
-  /// nor events.txt exists, or imu.txt is asked for and missing. A missing
+  /// nor events.txt exists, or imu.txt or range.txt is asked for and missing. A missing
   /// images.txt gives no frames (hasFrames() false).
   SequenceReader(std::string folder, const SequenceReaderOptions& options);
   ~SequenceReader();
@@ -97,6 +102,8 @@ class SequenceReader {
   std::size_t next_frame_ = 0;
   struct ImuStream;
   std::unique_ptr<ImuStream> imu_;
+  struct RangeStream;
+  std::unique_ptr<RangeStream> range_;
   std::uint64_t events_read_ = 0;
   TimeNs t_first_ = 0;
   bool have_first_ = false;

@@ -34,10 +34,10 @@
 /// evio::Error (bad input, not a filter state).
 
 #include <cstdint>
-#include <optional>
 #include <deque>
 #include <limits>
 #include <map>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <variant>

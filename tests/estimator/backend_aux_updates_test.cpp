@@ -83,6 +83,70 @@ TEST(BackendRangeFinder, UntriangulatedFeaturesTakeTheirDepthPriorFromTheRange) 
   EXPECT_GT(without.slam_depth_rel_error.front(), 0.8);
 }
 
+// The prior's geometry, exactly: points on the level plane z = 0.3 seen by a
+// camera tilted 35° and yawed, off the origin. Their normalised image
+// points give back 1/depth along the camera's z to rounding; rays near or
+// above the horizon and depths below the minimum give nothing.
+TEST(BackendRangeFinder, LevelPlaneDepthPriorIsExactForPointsOnThePlane) {
+  CameraClone c;
+  c.p_W_C = Vec3(1.5, -2.0, 7.3);
+  c.q_W_C = Quat(Mat3(Vec3(1.0, -1.0, -1.0).asDiagonal())) * so3::expQuat(Vec3(35.0 * M_PI / 180.0, 0.0, 0.0)) *
+            so3::expQuat(Vec3(0.0, 0.0, 0.9));  // looking down, tilted 35° about its x, rolled about its axis
+  const Mat3 R = c.R_W_C();
+  int checked = 0;
+  for (const Vec2 xy : {Vec2(0.0, 0.0), Vec2(3.0, 1.0), Vec2(-2.0, 4.0), Vec2(5.0, -3.0)}) {
+    const Vec3 p_W(c.p_W_C.x() + xy.x(), c.p_W_C.y() + xy.y(), 0.3);
+    const Vec3 p_C = R.transpose() * (p_W - c.p_W_C);
+    ASSERT_GT(p_C.z(), 0.0);
+    const auto rho = inverseDepthOnLevelPlane(c, Vec2(p_C.x() / p_C.z(), p_C.y() / p_C.z()), 0.3, 0.05);
+    ASSERT_TRUE(rho.has_value());
+    EXPECT_NEAR(*rho, 1.0 / p_C.z(), 1e-14 / p_C.z());
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);
+  // Rays in the vertical plane of the optical axis (55° below the horizon):
+  // 3° below the horizon (sin 0.052 < 0.1) and 10° above it give no prior,
+  // 8° below it (sin 0.139) does.
+  const Vec3 axis = R.col(2);
+  ASSERT_NEAR(std::asin(-axis.z()) * 180.0 / M_PI, 55.0, 1e-9);
+  const Vec3 level = Vec3(axis.x(), axis.y(), 0.0).normalized();
+  for (const double elevation_deg : {-3.0, 10.0, -8.0}) {
+    const double e = elevation_deg * M_PI / 180.0;
+    const Vec3 d_C = R.transpose() * (std::cos(e) * level + std::sin(e) * Vec3::UnitZ());
+    ASSERT_GT(d_C.z(), 0.0);  // in front of the camera
+    const auto rho = inverseDepthOnLevelPlane(c, Vec2(d_C.x() / d_C.z(), d_C.y() / d_C.z()), 0.3, 0.05);
+    EXPECT_EQ(rho.has_value(), elevation_deg == -8.0) << elevation_deg;
+  }
+  // The plane 7 m below, but a minimum depth of 20 m: no prior.
+  EXPECT_FALSE(inverseDepthOnLevelPlane(c, Vec2(0.0, 0.0), 0.3, 20.0).has_value());
+}
+
+// A range reading waits for max_delay_s of IMU beyond it, so a measurement
+// set stamped 20 ms before it that arrives after it is applied in time order
+// instead of being dropped as late (max_late_s 5 ms).
+TEST(BackendRangeFinder, AReadingDoesNotMakeEarlierMeasurementSetsLate) {
+  BackendSensors s{Camera(PinholeCamera(346, 260, Vec4(300, 300, 172.5, 129.5))), Pose(), 9.81, ImuSensor{},
+                   std::nullopt, 0};
+  s.imu = ImuSensor{0.004316, 0.0004316, 0.0002, 0.00002, 1000};
+  s.range_finder = RangeFinderSensor{Pose(), 0.1, 50.0, 0.02};
+  BackendOptions o;  // max_delay_s 0.1, max_late_s 0.005
+  Backend b(o, s);
+  b.initialize(ImuState{});
+  const auto imuUntil = [&b](int from_ms, int to_ms) {
+    for (int k = from_ms; k <= to_ms; ++k) b.addImu(ImuSample{k * kNsPerMs, Vec3(0, 0, 9.81), Vec3::Zero()});
+  };
+  imuUntil(1, 450);
+  b.addRange(400 * kNsPerMs, 5.0);
+  imuUntil(451, 460);
+  b.addMeasurementSet(MeasurementSet{380 * kNsPerMs, {}});
+  EXPECT_EQ(b.stats().measurements_late_dropped, 0);
+  EXPECT_EQ(b.stats().measurement_sets, 1);
+  EXPECT_EQ(b.stats().range_updates + b.stats().range_rejected, 0);  // still waiting
+  imuUntil(461, 600);
+  EXPECT_EQ(b.stats().range_updates + b.stats().range_rejected, 1);  // no SLAM features: rejected
+  EXPECT_TRUE(b.status().ok());
+}
+
 TEST(BackendZeroVelocity, BoundsVelocityWhenStill) {
   BackendSensors s{Camera(PinholeCamera(346, 260, Vec4(300, 300, 172.5, 129.5))), Pose(), 9.81, ImuSensor{},
                    std::nullopt, 0};

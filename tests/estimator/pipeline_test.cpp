@@ -301,10 +301,11 @@ TEST(Pipeline, UseRangeFeedsEveryValidRangeReadingToTheBackend) {
   SensorRig rig = io::readSensorsYaml(seq + "/sensors.yaml");
   rig.range_finder = RangeFinderSensor{Pose(), 0.1, 50.0, 0.02};
   io::writeSensorsYaml(seq + "/sensors.yaml", rig);
-  // 20 Hz readings over the run, every fourth without a return.
+  // 20 Hz readings up to 1.75 s of the 2 s run (a reading waits for
+  // backend.max_delay_s = 0.1 s of IMU after it), every fourth without a return.
   std::vector<io::RangeSample> ranges;
   int valid = 0;
-  for (int k = 1; k < 40; ++k) {
+  for (int k = 1; k <= 35; ++k) {
     ranges.push_back(io::RangeSample{secondsToNs(0.05 * k), k % 4 == 0 ? 0.0 : 3.0, k % 4 != 0});
     valid += k % 4 != 0;
   }

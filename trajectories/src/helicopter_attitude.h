@@ -11,6 +11,7 @@
 /// and the attitude one of order 2.
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "evio/core/options.h"
@@ -26,11 +27,15 @@ namespace evio::preset {
 inline void requireUpwardThrust(const std::string& field, double height_m, double duration_s, double gravity_mps2) {
   const double peak = std::abs(height_m) * motion::kSmoothStepPeakSecondDerivative / (duration_s * duration_s);
   const double shortest = std::sqrt(std::abs(height_m) * motion::kSmoothStepPeakSecondDerivative / gravity_mps2);
+  const auto num = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
+  };
   requireField(peak < gravity_mps2, field,
-               "a vertical move of " + std::to_string(std::abs(height_m)) + " m in " + std::to_string(duration_s) +
-                   " s peaks at " + std::to_string(peak) + " m/s^2, not below gravity (" +
-                   std::to_string(gravity_mps2) + " m/s^2): the rotors would have to pull down; make it longer than " +
-                   std::to_string(shortest) + " s");
+               "a vertical move of " + num(std::abs(height_m)) + " m in " + num(duration_s) + " s peaks at " +
+                   num(peak) + " m/s^2, not below gravity (" + num(gravity_mps2) +
+                   " m/s^2): the rotors would have to pull down; make it longer than " + num(shortest) + " s");
 }
 
 /// R_W_B of order 2 from the acceleration series a_W (order 2: a, jerk/1!, snap/2!).

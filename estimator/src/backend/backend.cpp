@@ -197,6 +197,12 @@ void Backend::process() {
   const TimeNs newest = imu_buffer_.empty() ? imu_at_state_.t_ns : imu_buffer_.back().t_ns;
   while (status_.ok() && !pending_.empty() && pending_.begin()->first.first <= newest) {
     const TimeNs t_ns = pending_.begin()->first.first;
+    // A range reading waits until max_delay_s of IMU lies beyond it: measurement
+    // sets stamped earlier may still come (EKLT's sets lag the event stream),
+    // and moving the state to the reading first would make them late.
+    if (std::holds_alternative<RangeItem>(pending_.begin()->second) &&
+        t_ns > newest - secondsToNs(options_.max_delay_s))
+      break;
     Item item = std::move(pending_.begin()->second);
     pending_.erase(pending_.begin());
     processItem(t_ns, item);
@@ -299,7 +305,11 @@ void Backend::processRange(double range_m) {
     return;
   }
   {
-    // Beam hit point h = o + range · d, o = p_W_B + R_W_B p_B_L, d = R_W_B R_B_L e_z.
+    // Beam hit point h = o + range · d, o = p_W_B + R_W_B p_B_L, d = R_W_B R_B_L e_z,
+    // kept for depth priors whatever the update below makes of the reading:
+    // when the SLAM features' depths are wrong (a prior made for another
+    // scene) the gate rejects the reading, and new features should still take
+    // the measured range rather than that prior.
     const Mat3 R = state_.imu.q_W_B.toRotationMatrix();
     const Vec3 o = state_.imu.p_W_B + R * rf.T_B_L.translation();
     range_hit_ = std::pair{state_.imu.t_ns, Vec3(o + range_m * (R * rf.T_B_L.rotation().col(2)))};

@@ -6,6 +6,7 @@
 #include "evio/estimator/backend/backend.h"
 #include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/msckf_update.h"
+#include "evio/estimator/backend/range_update.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/triangulation.h"
 #include "evio/estimator/backend/visual_models.h"
@@ -205,14 +206,7 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
 std::optional<double> Backend::rangeDepthPrior(const CameraClone& clone, const Vec2& z) const {
   if (!options_.use_range || !(options_.range_prior_relative_sigma > 0.0) || !range_hit_) return std::nullopt;
   if (nsToSeconds(clone.t_ns - range_hit_->first) > options_.range_prior_max_age_s) return std::nullopt;
-  // The ray c + s R_W_C (α, β, 1) meets the level plane through the hit point h
-  // at s = (h_z − c_z) / (R_W_C (α, β, 1))_z; s is the depth along the
-  // camera's z axis, so ρ0 = 1/s.
-  const Vec3 u = clone.R_W_C() * Vec3(z.x(), z.y(), 1.0);
-  if (!(u.z() < -0.1 * u.norm())) return std::nullopt;  // within about 6° of the horizon or above it
-  const double s = (range_hit_->second.z() - clone.p_W_C.z()) / u.z();
-  if (!(s >= options_.triangulation_min_depth_m) || !std::isfinite(s)) return std::nullopt;
-  return 1.0 / s;
+  return inverseDepthOnLevelPlane(clone, z, range_hit_->second.z(), options_.triangulation_min_depth_m);
 }
 
 void Backend::initializeSlamFeatures(const std::vector<FeatureId>& candidates) {

@@ -34,6 +34,15 @@ bool rangeToPlane(const Vec3& o, const Vec3& d, const Vec3& q1, const Vec3& q2, 
   return true;
 }
 
+std::optional<double> inverseDepthOnLevelPlane(const CameraClone& camera, const Vec2& z, double plane_z_m,
+                                               double min_depth_m) {
+  const Vec3 u = camera.R_W_C() * Vec3(z.x(), z.y(), 1.0);
+  if (!(u.z() < -0.1 * u.norm())) return std::nullopt;  // near or above the horizon
+  const double s = (plane_z_m - camera.p_W_C.z()) / u.z();
+  if (!std::isfinite(s) || !(s >= min_depth_m)) return std::nullopt;
+  return 1.0 / s;
+}
+
 bool rangeResidual(const FilterState& state, const Pose& T_B_L, double measured_range_m, double max_angle_rad,
                    Eigen::Matrix<double, 1, Eigen::Dynamic>* H, double* r) {
   const Mat3 R = state.imu.q_W_B.toRotationMatrix();

@@ -173,6 +173,8 @@ void PipelineRun::setup() {
   ro.read_range = options_.backend.use_range;
   if (options_.backend.use_range && !rig_.rig.range_finder)
     throw Error("backend.use_range: " + rig_.source + " of " + sequence_ + " has no range finder");
+  if (options_.backend.use_range && !fs::exists(fs::path(sequence_) / "range.txt"))
+    throw Error("backend.use_range: " + (fs::path(sequence_) / "range.txt").string() + " not found");
   ro.event_width = event_cam.camera.width();
   ro.event_height = event_cam.camera.height();
   ro.calibration = rig_.describe(event_cam);

@@ -3,7 +3,9 @@
 /// `range.txt`: the readings of a single-beam laser range finder, one line
 /// per measurement, 3 columns:
 ///   t  range_m  valid
-/// t in seconds; valid = 1: range_m is the measured range along the beam
+/// t in seconds on the camera clock (the simulator's true time; imu.txt is
+/// stamped on the IMU clock, t_imu = t_cam + time_offset_cam_imu); valid = 1:
+/// range_m is the measured range along the beam
 /// (m, >= 0); valid = 0: no return (no surface, or the surface closer than
 /// the minimum or farther than the maximum range), range_m is written as 0
 /// and means nothing. Every measurement has a line, so the sample clock is

@@ -94,9 +94,11 @@ struct BackendOptions {
   double max_velocity_mps = 100.0;  ///< a faster velocity estimate means divergence, m/s
 
   // Optional updates -------------------------------------------------------------------
-  /// Feed the sequence's range.txt to the range update (xVIO's range-VIO:
-  /// the laser range finder fixes the scale of the SLAM features near its
-  /// beam). Needs a range finder in sensors.yaml.
+  /// The laser range finder. The pipeline feeds the sequence's range.txt to
+  /// Backend::addRange (range updates, xVIO's range-VIO: the scale of the
+  /// SLAM features near the beam) only when this is set, and needs a range
+  /// finder in sensors.yaml; in the backend the flag enables the depth
+  /// priors below (readings given to addRange are range updates either way).
   bool use_range = false;
   /// With use_range, a SLAM feature that cannot be triangulated takes its
   /// depth prior from the latest range reading instead of slam_min_depth_m:

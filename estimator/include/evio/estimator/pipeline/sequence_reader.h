@@ -9,7 +9,8 @@
 ///
 /// Order: an IMU sample stamped t_imu is placed at camera time
 /// t = t_imu − time_offset_cam_imu (sensors.yaml: t_imu = t_cam + offset).
-/// Before the IMU sample or frame at time T come all events with t < T; at
+/// Before the IMU sample, frame or range reading at time T come all events
+/// with t < T; at
 /// equal times the IMU sample comes before the frame, and the frame before the
 /// range reading.
 ///

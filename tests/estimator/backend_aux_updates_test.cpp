@@ -94,7 +94,7 @@ TEST(BackendRangeFinder, LevelPlaneDepthPriorIsExactForPointsOnThePlane) {
             so3::expQuat(Vec3(0.0, 0.0, 0.9));  // looking down, tilted 35° about its x, rolled about its axis
   const Mat3 R = c.R_W_C();
   int checked = 0;
-  for (const Vec2 xy : {Vec2(0.0, 0.0), Vec2(3.0, 1.0), Vec2(-2.0, 4.0), Vec2(5.0, -3.0)}) {
+  for (const Vec2& xy : {Vec2(0.0, 0.0), Vec2(3.0, 1.0), Vec2(-2.0, 4.0), Vec2(5.0, -3.0)}) {
     const Vec3 p_W(c.p_W_C.x() + xy.x(), c.p_W_C.y() + xy.y(), 0.3);
     const Vec3 p_C = R.transpose() * (p_W - c.p_W_C);
     ASSERT_GT(p_C.z(), 0.0);

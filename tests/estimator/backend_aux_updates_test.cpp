@@ -84,7 +84,7 @@ TEST(BackendRangeFinder, UntriangulatedFeaturesTakeTheirDepthPriorFromTheRange) 
 }
 
 // The prior's geometry, exactly: points on the level plane z = 0.3 seen by a
-// camera tilted 35° and yawed, off the origin. Their normalised image
+// camera tilted 35° and rolled, off the origin. Their normalised image
 // points give back 1/depth along the camera's z to rounding; rays near or
 // above the horizon and depths below the minimum give nothing.
 TEST(BackendRangeFinder, LevelPlaneDepthPriorIsExactForPointsOnThePlane) {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "evio/core/so3.h"
 #include "evio/core/error.h"
+#include "evio/core/so3.h"
 #include "evio/trajectories/flight.h"
 #include "evio/trajectories/hover.h"
 #include "evio/trajectories/trajectory_factory.h"

@@ -34,6 +34,10 @@ struct RendererOptions {
   int tile_px = 16;          ///< tile edge length in pixels
   int supersampling = 1;     ///< n: n × n radiance rays per pixel
   bool check_viewpoint = true;  ///< throw when the camera is inside a solid source
+  /// Shade with the AVX2 code path when the CPU has it. Both paths do the
+  /// same float operations in the same order (no FMA), so the output is the
+  /// same bit for bit; off forces the baseline x86-64 path (tests, timing).
+  bool avx2 = true;
 
   template <class V>
   void fields(V& v) {
@@ -41,6 +45,7 @@ struct RendererOptions {
     v("tile_px", tile_px, "tile edge length (px)");
     v("supersampling", supersampling, "n x n radiance rays per pixel");
     v("check_viewpoint", check_viewpoint, "error when the camera is inside geometry");
+    v("avx2", avx2, "use the AVX2 shading path when the CPU has it (same output)");
   }
   void validate() const {
     requireInRange("threads", threads, 0, 1024);
@@ -96,6 +101,13 @@ class Renderer {
   struct Scratch;
   void renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
                   RenderStats* counts, Scratch* scratch) const;
+  /// renderTile compiled for AVX2 (called only when avx2_).
+  void renderTileAvx2(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
+                      RenderStats* counts, Scratch* scratch) const;
+  /// The body of both, inlined into each.
+  template <bool kAvx2>
+  void shadeTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
+                 RenderStats* counts, Scratch* scratch) const;
 
   const scenes::Scene& scene_;
   Camera camera_;
@@ -103,6 +115,7 @@ class Renderer {
   std::vector<Eigen::Vector3f> bearings_;     ///< centre ray per pixel, row-major
   std::vector<Eigen::Vector3f> sub_bearings_; ///< n² rays per pixel when supersampling > 1
   float pixel_angle_rad_ = 0.0f;              ///< ≈ 1 / fx, for the texture footprint
+  bool avx2_ = false;                         ///< options_.avx2 and the CPU has AVX2
 };
 
 }  // namespace evio::simulator

@@ -9,6 +9,7 @@
 #include "evio/core/io/image_file.h"
 #include "evio/core/random_stream.h"
 #include "evio/scenes/noise.h"
+#include "avx2.h"
 
 namespace evio::scenes {
 
@@ -184,5 +185,80 @@ float Texture::shapes(const Eigen::Vector2f& uv, float footprint, float backgrou
   }
   return value;
 }
+
+#if defined(EVIO_SCENES_AVX2)
+EVIO_AVX2 void Texture::evaluate8Avx2(const float* px, const float* py, const float* pz, const float* u,
+                                      const float* v, const float* footprint, float* out) const {
+  switch (kind_) {
+    case Kind::kNoise: {  // noise() lane by lane
+      const NoiseConstants& c = noise_;
+      alignas(32) float q[3][8], patch[8], fp[8], detail[8];
+      const __m256 x = _mm256_loadu_ps(px), y = _mm256_loadu_ps(py), z = _mm256_loadu_ps(pz);
+      const __m256 inv_patch = _mm256_set1_ps(c.inv_patch_wl), inv_detail = _mm256_set1_ps(c.inv_detail_wl);
+      _mm256_store_ps(q[0], _mm256_mul_ps(x, inv_patch));
+      _mm256_store_ps(q[1], _mm256_mul_ps(y, inv_patch));
+      _mm256_store_ps(q[2], _mm256_mul_ps(z, inv_patch));
+      lattice_->value8Avx2(q[0], q[1], q[2], patch);
+      // smoothstep(threshold − 0.08, threshold + 0.08, patch)
+      const float e0 = c.threshold - 0.08f, e1 = c.threshold + 0.08f;
+      const __m256 t = avx2::clamp01(
+          _mm256_div_ps(_mm256_sub_ps(_mm256_load_ps(patch), _mm256_set1_ps(e0)), _mm256_set1_ps(e1 - e0)));
+      const __m256 rock = _mm256_mul_ps(_mm256_mul_ps(t, t), _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_set1_ps(2.0f), t)));
+      const __m256 base = _mm256_add_ps(_mm256_set1_ps(c.dust), _mm256_mul_ps(rock, _mm256_set1_ps(c.rock_minus_dust)));
+      _mm256_store_ps(q[0], _mm256_add_ps(_mm256_mul_ps(x, inv_detail), _mm256_set1_ps(11.3f)));
+      _mm256_store_ps(q[1], _mm256_add_ps(_mm256_mul_ps(y, inv_detail), _mm256_set1_ps(29.1f)));
+      _mm256_store_ps(q[2], _mm256_add_ps(_mm256_mul_ps(z, inv_detail), _mm256_set1_ps(5.7f)));
+      _mm256_store_ps(fp, _mm256_mul_ps(_mm256_loadu_ps(footprint), inv_detail));
+      lattice_->fbm8Avx2(q[0], q[1], q[2], options_.octaves, 0.6f, fp, detail);
+      const __m256 r = _mm256_mul_ps(
+          base, _mm256_add_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(_mm256_set1_ps(c.contrast), _mm256_load_ps(detail))));
+      _mm256_storeu_ps(out, avx2::clamp01(r));
+      return;
+    }
+    case Kind::kShapes:
+    case Kind::kCollage: {  // the baked texture inside [0, cols] × [0, rows] texels, else the background
+      const __m256 texel = _mm256_set1_ps(texel_m_);
+      const __m256 s = _mm256_div_ps(_mm256_loadu_ps(u), texel), t = _mm256_div_ps(_mm256_loadu_ps(v), texel);
+      const __m256 zero = _mm256_setzero_ps();
+      const __m256 outside = _mm256_or_ps(
+          _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_LT_OQ), _mm256_cmp_ps(t, zero, _CMP_LT_OQ)),
+          _mm256_or_ps(_mm256_cmp_ps(s, _mm256_set1_ps(static_cast<float>(mip_.level(0).cols)), _CMP_GT_OQ),
+                       _mm256_cmp_ps(t, _mm256_set1_ps(static_cast<float>(mip_.level(0).rows)), _CMP_GT_OQ)));
+      alignas(32) float ss[8], tt[8], fp[8], r[8];
+      _mm256_store_ps(ss, s);
+      _mm256_store_ps(tt, t);
+      _mm256_store_ps(fp, _mm256_div_ps(_mm256_loadu_ps(footprint), texel));
+      mip_.sample8Avx2(ss, tt, fp, r);
+      _mm256_storeu_ps(out, _mm256_blendv_ps(_mm256_load_ps(r), _mm256_set1_ps(static_cast<float>(options_.background)), outside));
+      return;
+    }
+    case Kind::kImage: {  // image() lane by lane
+      const auto& o = options_;
+      const float sx = static_cast<float>(image_.cols) / static_cast<float>(o.size_m.x());
+      const float sy = static_cast<float>(image_.rows) / static_cast<float>(o.size_m.y());
+      alignas(32) float ss[8], tt[8], fp[8], r[8];
+      _mm256_store_ps(ss, _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(u), _mm256_set1_ps(static_cast<float>(o.offset_m.x()))),
+                                        _mm256_set1_ps(sx)));
+      _mm256_store_ps(tt, _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(v), _mm256_set1_ps(static_cast<float>(o.offset_m.y()))),
+                                        _mm256_set1_ps(sy)));
+      _mm256_store_ps(fp, _mm256_mul_ps(_mm256_loadu_ps(footprint), _mm256_set1_ps(sx)));
+      mip_.sample8Avx2(ss, tt, fp, r);
+      _mm256_storeu_ps(out, avx2::clamp01(_mm256_mul_ps(_mm256_set1_ps(static_cast<float>(o.gain)), _mm256_load_ps(r))));
+      return;
+    }
+    case Kind::kConstant:
+    case Kind::kChecker:
+      break;
+  }
+  for (int k = 0; k < 8; ++k)
+    out[k] = evaluate(Eigen::Vector3f(px[k], py[k], pz[k]), Eigen::Vector2f(u[k], v[k]), footprint[k]);
+}
+#else
+void Texture::evaluate8Avx2(const float* px, const float* py, const float* pz, const float* u, const float* v,
+                            const float* footprint, float* out) const {
+  for (int k = 0; k < 8; ++k)
+    out[k] = evaluate(Eigen::Vector3f(px[k], py[k], pz[k]), Eigen::Vector2f(u[k], v[k]), footprint[k]);
+}
+#endif
 
 }  // namespace evio::scenes

@@ -7,8 +7,8 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-#if defined(__GNUC__) && defined(__x86_64__)
-#include <immintrin.h>
+#include "avx2.h"
+#if defined(EVIO_SCENES_AVX2)
 #define EVIO_VALUE_NOISE_AVX2 1  // an AVX2 path chosen at run time
 #endif
 
@@ -112,32 +112,18 @@ void ValueLattice::octaveValues(const Eigen::Vector3f& p, int first, int count, 
 
 #if defined(EVIO_VALUE_NOISE_AVX2)
 namespace {
-#define EVIO_AVX2_INLINE __attribute__((target("avx2"), always_inline)) inline
 /// The lattice values at indices z + y + x: 4 bytes read at each, the first
 /// (little endian) kept, sign-extended.
 EVIO_AVX2_INLINE __m256 gatherValues(const int* base, __m256i z, __m256i y, __m256i x) {
   const __m256i g = _mm256_i32gather_epi32(base, _mm256_add_epi32(z, _mm256_add_epi32(y, x)), 1);
   return _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(g, 24), 24));
 }
-EVIO_AVX2_INLINE __m256 lerp8(__m256 a, __m256 b, __m256 s) {
-  return _mm256_add_ps(a, _mm256_mul_ps(s, _mm256_sub_ps(b, a)));
-}
-#undef EVIO_AVX2_INLINE
-}  // namespace
 
-// octaveValues with eight octaves side by side (AVX2, no FMA: the same float
-// operations in the same order as octave()).
-__attribute__((target("avx2"))) void ValueLattice::octaveValues8(const Eigen::Vector3f& p, int first, int count,
-                                                                   float* out) const {
-  const __m256 px = _mm256_set1_ps(p.x()), py = _mm256_set1_ps(p.y()), pz = _mm256_set1_ps(p.z());
-  const __m256i m = _mm256_set1_epi32(kSize - 1), one = _mm256_set1_epi32(1);
-  const auto k = static_cast<std::size_t>(first);
-  __m256 q[3];
-  for (std::size_t i = 0; i < 3; ++i)  // (r_i0 x + (r_i1 y + r_i2 z)) + t_i, as in octaveValues
-    q[i] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i][k]), px),
-                                       _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i + 1][k]), py),
-                                                     _mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i + 2][k]), pz))),
-                         _mm256_loadu_ps(&offset_soa_[i][k]));
+/// ValueLattice::value at eight points q (lattice units), lane by lane the
+/// float operations of value() in its order (detail::floorInt, detail::fade,
+/// seven interpolations, × 1/127).
+EVIO_AVX2_INLINE __m256 latticeValue8(const __m256 (&q)[3], const int* base) {
+  const __m256i m = _mm256_set1_epi32(ValueLattice::kSize - 1), one = _mm256_set1_epi32(1);
   __m256i lo[3], hi[3];
   __m256 f[3];
   for (int i = 0; i < 3; ++i) {
@@ -152,20 +138,85 @@ __attribute__((target("avx2"))) void ValueLattice::octaveValues8(const Eigen::Ve
     lo[i] = _mm256_and_si256(ix, m);
     hi[i] = _mm256_and_si256(_mm256_add_epi32(ix, one), m);
   }
+  static_assert(ValueLattice::kSize == 64, "the shifts below assume a 64-cell lattice");
   lo[1] = _mm256_slli_epi32(lo[1], 6);
   hi[1] = _mm256_slli_epi32(hi[1], 6);
   lo[2] = _mm256_slli_epi32(lo[2], 12);
   hi[2] = _mm256_slli_epi32(hi[2], 12);
-  const auto* base = reinterpret_cast<const int*>(v_.data());
-  const __m256 a00 = lerp8(gatherValues(base, lo[2], lo[1], lo[0]), gatherValues(base, lo[2], lo[1], hi[0]), f[0]);
-  const __m256 a10 = lerp8(gatherValues(base, lo[2], hi[1], lo[0]), gatherValues(base, lo[2], hi[1], hi[0]), f[0]);
-  const __m256 a01 = lerp8(gatherValues(base, hi[2], lo[1], lo[0]), gatherValues(base, hi[2], lo[1], hi[0]), f[0]);
-  const __m256 a11 = lerp8(gatherValues(base, hi[2], hi[1], lo[0]), gatherValues(base, hi[2], hi[1], hi[0]), f[0]);
-  const __m256 r =
-      _mm256_mul_ps(lerp8(lerp8(a00, a10, f[1]), lerp8(a01, a11, f[1]), f[2]), _mm256_set1_ps(1.0f / 127.0f));
+  using scenes::avx2::lerp;
+  const __m256 a00 = lerp(gatherValues(base, lo[2], lo[1], lo[0]), gatherValues(base, lo[2], lo[1], hi[0]), f[0]);
+  const __m256 a10 = lerp(gatherValues(base, lo[2], hi[1], lo[0]), gatherValues(base, lo[2], hi[1], hi[0]), f[0]);
+  const __m256 a01 = lerp(gatherValues(base, hi[2], lo[1], lo[0]), gatherValues(base, hi[2], lo[1], hi[0]), f[0]);
+  const __m256 a11 = lerp(gatherValues(base, hi[2], hi[1], lo[0]), gatherValues(base, hi[2], hi[1], hi[0]), f[0]);
+  return _mm256_mul_ps(lerp(lerp(a00, a10, f[1]), lerp(a01, a11, f[1]), f[2]), _mm256_set1_ps(1.0f / 127.0f));
+}
+}  // namespace
+
+// octaveValues with eight octaves side by side (AVX2, no FMA: the same float
+// operations in the same order as octave()).
+EVIO_AVX2 void ValueLattice::octaveValues8(const Eigen::Vector3f& p, int first, int count, float* out) const {
+  const __m256 px = _mm256_set1_ps(p.x()), py = _mm256_set1_ps(p.y()), pz = _mm256_set1_ps(p.z());
+  const auto k = static_cast<std::size_t>(first);
+  __m256 q[3];
+  for (std::size_t i = 0; i < 3; ++i)  // (r_i0 x + (r_i1 y + r_i2 z)) + t_i, as in octaveValues
+    q[i] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i][k]), px),
+                                       _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i + 1][k]), py),
+                                                     _mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i + 2][k]), pz))),
+                         _mm256_loadu_ps(&offset_soa_[i][k]));
   alignas(32) float all[8];
-  _mm256_store_ps(all, r);
+  _mm256_store_ps(all, latticeValue8(q, reinterpret_cast<const int*>(v_.data())));
   for (int j = 0; j < count; ++j) out[j] = all[j];
+}
+
+EVIO_AVX2 void ValueLattice::value8Avx2(const float* x, const float* y, const float* z, float* out) const {
+  const __m256 q[3] = {_mm256_loadu_ps(x), _mm256_loadu_ps(y), _mm256_loadu_ps(z)};
+  _mm256_storeu_ps(out, latticeValue8(q, reinterpret_cast<const int*>(v_.data())));
+}
+
+EVIO_AVX2 void ValueLattice::fbm8Avx2(const float* x, const float* y, const float* z, int octaves, float gain,
+                                      const float* footprint, float* out) const {
+  // fbm() lane by lane: the same norm, level-of-detail weights and sum order.
+  if (octaves > kMaxOctaves) octaves = kMaxOctaves;
+  float norm = 0.0f;
+  {
+    float a = 1.0f;
+    for (int o = 0; o < octaves; ++o, a *= gain) norm += a;
+  }
+  const __m256 px = _mm256_loadu_ps(x), py = _mm256_loadu_ps(y), pz = _mm256_loadu_ps(z);
+  const __m256 fp = _mm256_loadu_ps(footprint);
+  const __m256 four = _mm256_set1_ps(4.0f), eight = _mm256_set1_ps(8.0f), half = _mm256_set1_ps(0.5f);
+  __m256 ratio = _mm256_blendv_ps(_mm256_set1_ps(1e30f), _mm256_div_ps(_mm256_set1_ps(1.0f), fp),
+                                  _mm256_cmp_ps(fp, _mm256_setzero_ps(), _CMP_GT_OQ));
+  __m256 active = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  __m256 sum = _mm256_setzero_ps();
+  const auto* base = reinterpret_cast<const int*>(v_.data());
+  float amp = 1.0f;
+  for (int o = 0; o < octaves; ++o, ratio = _mm256_mul_ps(ratio, half), amp *= gain) {
+    active = _mm256_and_ps(active, _mm256_cmp_ps(ratio, four, _CMP_NLE_UQ));  // fbm stops at ratio <= 4
+    if (_mm256_movemask_ps(active) == 0) break;
+    const __m256 weight = _mm256_blendv_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(_mm256_sub_ps(ratio, four), _mm256_set1_ps(0.25f)),
+                                           _mm256_cmp_ps(ratio, eight, _CMP_LT_OQ));
+    const __m256 scale = _mm256_mul_ps(weight, _mm256_set1_ps(amp));
+    const auto k = static_cast<std::size_t>(o);
+    __m256 q[3];
+    for (std::size_t i = 0; i < 3; ++i)  // (r_i0 x + (r_i1 y + r_i2 z)) + t_i, as in octaveValues
+      q[i] = _mm256_add_ps(
+          _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(rotation_soa_[3 * i][k]), px),
+                        _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(rotation_soa_[3 * i + 1][k]), py),
+                                      _mm256_mul_ps(_mm256_set1_ps(rotation_soa_[3 * i + 2][k]), pz))),
+          _mm256_set1_ps(offset_soa_[i][k]));
+    const __m256 v = latticeValue8(q, base);
+    sum = _mm256_blendv_ps(sum, _mm256_add_ps(sum, _mm256_mul_ps(scale, v)), active);
+  }
+  _mm256_storeu_ps(out, _mm256_div_ps(sum, _mm256_set1_ps(norm)));
+}
+#else
+void ValueLattice::value8Avx2(const float* x, const float* y, const float* z, float* out) const {
+  for (int k = 0; k < 8; ++k) out[k] = value(Eigen::Vector3f(x[k], y[k], z[k]));
+}
+void ValueLattice::fbm8Avx2(const float* x, const float* y, const float* z, int octaves, float gain,
+                            const float* footprint, float* out) const {
+  for (int k = 0; k < 8; ++k) out[k] = fbm(Eigen::Vector3f(x[k], y[k], z[k]), octaves, gain, footprint[k]);
 }
 #endif
 

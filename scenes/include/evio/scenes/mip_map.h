@@ -29,6 +29,11 @@ class MipMap {
   /// i + 0.5) with a footprint of `footprint` level-0 texels.
   float sample(float s, float t, float footprint) const;
 
+  /// sample() of eight points at once with AVX2 (only on a CPU that has it):
+  /// out[k] = sample(s[k], t[k], footprint[k]), bit for bit. Lanes that need
+  /// wrapping or clamping go through sample() itself.
+  void sample8Avx2(const float* s, const float* t, const float* footprint, float* out) const;
+
   int levels() const { return static_cast<int>(levels_.size()); }
   const cv::Mat& level(int l) const { return levels_[static_cast<std::size_t>(l)]; }
 
@@ -42,8 +47,13 @@ class MipMap {
     float fcols = 0.0f, frows = 0.0f;
   };
   float bilinear(int level, float s, float t) const;
-  std::vector<cv::Mat> levels_;
+  cv::Mat texels_;               ///< every level's texels, level after level, rows unpadded (1 × N), + one 0
+  std::vector<cv::Mat> levels_;  ///< views into texels_
   std::vector<Level> table_;
+  /// Per level, as the 8-lane lookup gathers them: first texel in texels_,
+  /// columns, rows, and the same as floats.
+  std::vector<int> first_, cols_, rows_;
+  std::vector<float> fcols_, frows_;
   float fcols0_ = 0.0f, frows0_ = 0.0f;  ///< level-0 size as floats
   bool repeat_ = true;
 };

@@ -133,6 +133,17 @@ class Scene {
   /// Albedo ρ at a hit; footprint_m is the pixel size on the surface (m).
   float albedo(const SurfaceHit& hit, float footprint_m) const;
 
+  /// The material index of mesh `mesh`, and the number of materials.
+  int materialOf(unsigned mesh) const { return meshes_[mesh].material; }
+  int materialCount() const { return static_cast<int>(materials_.size()); }
+  /// albedo() of eight hits of one material, given their points p_W, surface
+  /// coordinates uv (m) and footprints as columns, with AVX2 across the hits
+  /// (only on a CPU that has it): bit for bit albedo()'s values.
+  void albedo8Avx2(int material, const float* px, const float* py, const float* pz, const float* u, const float* v,
+                   const float* footprint_m, float* out) const {
+    materials_[static_cast<std::size_t>(material)].texture->evaluate8Avx2(px, py, pz, u, v, footprint_m, out);
+  }
+
   /// Number of lights that need an occlusion ray (sun, point, spot).
   int shadowLightCount() const { return static_cast<int>(direct_.size()); }
 

@@ -120,6 +120,12 @@ class Texture {
   /// and a pixel footprint of footprint_m (m; 0 = full detail).
   float evaluate(const Eigen::Vector3f& p_W, const Eigen::Vector2f& uv_m, float footprint_m) const;
 
+  /// evaluate() at eight points (p_W = (px, py, pz)[k], uv_m = (u, v)[k],
+  /// footprint[k]) with AVX2 across the points (only on a CPU that has it):
+  /// out[k] is evaluate()'s value bit for bit.
+  void evaluate8Avx2(const float* px, const float* py, const float* pz, const float* u, const float* v,
+                     const float* footprint, float* out) const;
+
   const TextureOptions& options() const { return options_; }
 
  private:

@@ -35,6 +35,13 @@ class ValueLattice {
   /// Multi-octave value noise (see the file comment); about [−1, 1].
   float fbm(const Eigen::Vector3f& p, int octaves, float gain, float footprint = 0.0f) const;
 
+  /// value() at eight points (x[k], y[k], z[k]) and fbm() at eight points
+  /// with footprint[k], with AVX2 across the points (only on a CPU that has
+  /// it): bit for bit the scalar results.
+  void value8Avx2(const float* x, const float* y, const float* z, float* out) const;
+  void fbm8Avx2(const float* x, const float* y, const float* z, int octaves, float gain, const float* footprint,
+                float* out) const;
+
   /// Octave o alone, n(R_o 2^o p + t_o), through the scalar value(): the
   /// reference for fbm's terms, which are evaluated four at a time.
   float octave(const Eigen::Vector3f& p, int o) const {

@@ -104,6 +104,9 @@ class Renderer {
   /// renderTile compiled for AVX2 (called only when avx2_).
   void renderTileAvx2(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
                       RenderStats* counts, Scratch* scratch) const;
+  /// The AVX2 copy's albedo pass (renderer.cpp).
+  template <class Shaded, class Footprint>
+  void albedoPassAvx2(std::size_t rays, const Shaded& shaded, const Footprint& footprint, Scratch* scratch) const;
   /// The body of both, inlined into each.
   template <bool kAvx2>
   void shadeTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,

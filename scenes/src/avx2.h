@@ -12,6 +12,7 @@
 
 #define EVIO_AVX2 __attribute__((target("avx2")))
 #define EVIO_AVX2_INLINE __attribute__((target("avx2"), always_inline)) inline
+#define EVIO_AVX2_LAMBDA __attribute__((target("avx2"), always_inline))  // after a lambda's parameter list
 
 namespace evio::scenes::avx2 {
 

@@ -56,6 +56,9 @@ Scene::Scene(const SceneDescription& description, const SceneBuildOptions& optio
     data.reflectance = Reflectance(m);
     data.texture = std::make_unique<Texture>(m.albedo, streamSeed(o.seed, "material/" + m.name),
                                              description_.base_dir, where + ".albedo");
+    oren_nayar_.push_back(data.reflectance.orenNayar() ? 1 : 0);
+    on_a_.push_back(data.reflectance.a());
+    on_b_.push_back(data.reflectance.b());
     materials_.push_back(std::move(data));
   }
   // Lights.
@@ -193,9 +196,9 @@ void Scene::buildShadeMeshes() {
     s.triangles.resize(m.triangles.size());
     for (std::size_t i = 0; i < m.triangles.size(); ++i) {
       const Eigen::Vector3i& t = m.triangles[i];
-      s.triangles[i] = ShadeTriangle{{static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
-                                      static_cast<std::uint32_t>(t[2])},
-                                     meshes_[g].face_normals[i]};
+      s.triangles[i] = ShadeTriangle{meshes_[g].face_normals[i],
+                                     {static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+                                      static_cast<std::uint32_t>(t[2])}};
     }
   }
 }

@@ -11,6 +11,7 @@
 
 #include "evio/core/error.h"
 #include "evio/scenes/embree_util.h"
+#include "renderer_scratch.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
 #define EVIO_RENDER_AVX2 1  // an AVX2 copy of the shading code, chosen at run time
@@ -52,23 +53,6 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
 #endif
 }
 
-/// Per-thread buffers of one tile, reused from tile to tile.
-struct Renderer::Scratch {
-  std::vector<RTCRayHit> rays;
-  std::vector<Eigen::Vector3f> dirs;
-  std::vector<scenes::SurfaceHit> hits;
-  std::vector<float> albedo;
-  std::vector<scenes::LightSample> light;
-  std::vector<RTCRay> shadow;
-  std::vector<std::uint32_t> shadow_slot;
-  // The AVX2 albedo pass: footprints, materials, and the shaded rays
-  // grouped by material.
-  std::vector<float> footprint;
-  std::vector<int> material;
-  std::vector<std::uint32_t> by_material;
-  std::vector<std::uint32_t> material_start;  ///< first entry of each material in by_material (+ the end)
-  std::vector<std::uint32_t> material_fill;
-};
 
 RenderOutput Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderStats* stats) const {
   RenderOutput out;
@@ -211,6 +195,13 @@ template <bool kAvx2>
 
   // Shading inputs and occlusion rays.
   const float footprint_scale = pixel_angle_rad_ / static_cast<float>(n);
+  if constexpr (kAvx2) {
+    if (!super) {  // eight rays at a time (renderer_avx2.cpp)
+      counts->shadow_rays = shadePacketsAvx2(rays, footprint_scale, scratch);
+      writeOutputs(x0, y0, x1, y1, velocity, out, *scratch);
+      return;
+    }
+  }
   std::size_t shadows = 0;
   // The shading data of large meshes is mostly not in cache: fetch the
   // triangle record kAhead hits ahead and its vertices kAhead / 2 ahead.

@@ -57,6 +57,7 @@ class Reflectance {
     return kInvPi * (a_ + (s > 0.0f ? b_ * s / m : 0.0f));
   }
 
+  bool orenNayar() const { return oren_nayar_; }
   float a() const { return a_; }
   float b() const { return b_; }
 

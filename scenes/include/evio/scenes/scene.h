@@ -94,6 +94,33 @@ struct LightSample {
   float e_normal = 0.0f;
 };
 
+/// Surface hits as columns, ray r in entry r (the renderer's AVX2 path):
+/// the fields of SurfaceHit, meaningless where the ray missed. Sized in
+/// whole groups of eight.
+struct SurfaceHitColumns {
+  std::vector<float> px, py, pz;  ///< world point (m)
+  std::vector<float> nx, ny, nz;  ///< unit shading normal
+  std::vector<float> gx, gy, gz;  ///< unit geometric normal
+  std::vector<float> u, v;        ///< surface coordinates (m)
+  std::vector<float> b1, b2;      ///< barycentric weights of the 2nd and 3rd vertex
+  std::vector<std::uint32_t> mesh, prim;
+  void resize(std::size_t n) {
+    for (auto* c : {&px, &py, &pz, &nx, &ny, &nz, &gx, &gy, &gz, &u, &v, &b1, &b2}) c->resize(n);
+    mesh.resize(n);
+    prim.resize(n);
+  }
+};
+
+/// Eight rays' directions and hits as Embree returned them, and the shading
+/// inputs and outputs of the 8-lane functions of Scene (columns).
+struct LightColumns {
+  std::vector<float> wx, wy, wz;  ///< unit direction to the light
+  std::vector<float> e;           ///< irradiance on a surface facing it (W/m²); 0 blocked or unreachable
+  void resize(std::size_t n) {
+    for (auto* c : {&wx, &wy, &wz, &e}) c->resize(n);
+  }
+};
+
 class Scene {
  public:
   /// Generates and imports every source, builds the Embree BVH and, if
@@ -143,6 +170,27 @@ class Scene {
                    const float* footprint_m, float* out) const {
     materials_[static_cast<std::size_t>(material)].texture->evaluate8Avx2(px, py, pz, u, v, footprint_m, out);
   }
+
+  // The 8-lane (AVX2) shading functions: each works on entries [at, at + 8)
+  // of its columns and is, lane by lane, its scalar counterpart bit for bit
+  // (the same float operations in the same order, no FMA). Only on a CPU
+  // with AVX2. Test: Renderer.Avx2PathRendersTheSameBitsAsTheBaselinePath.
+
+  /// surfaceHit() of rays[at .. at + 8) whose directions are (dx, dy, dz);
+  /// lanes whose ray missed (geomID invalid) are left as they are.
+  void surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz, std::size_t at,
+                        SurfaceHitColumns* hits) const;
+  /// shadowRay(k, ·) of eight hits: the light sample (direction, and the
+  /// irradiance, 0 where shadowRay returns false), the ray origin and t_far;
+  /// returns the mask of lanes that need an occlusion ray (bit j = lane j).
+  int shadowRays8Avx2(int k, const SurfaceHitColumns& hits, std::size_t at, LightColumns* light, float* ox,
+                      float* oy, float* oz, float* t_far) const;
+  /// radiance() of eight hits seen along (dx, dy, dz) (to_viewer = −d),
+  /// given their material indices, albedos and one LightColumns per shadow
+  /// light.
+  void radiance8Avx2(const SurfaceHitColumns& hits, const int* material, const float* dx, const float* dy,
+                     const float* dz, const float* albedo, const LightColumns* lights, std::size_t at,
+                     float* out) const;
 
   /// Number of lights that need an occlusion ray (sun, point, spot).
   int shadowLightCount() const { return static_cast<int>(direct_.size()); }
@@ -195,9 +243,9 @@ class Scene {
     Eigen::Vector3f n;   ///< unit vertex normal
     Eigen::Vector2f uv;  ///< surface coordinates (m)
   };
-  struct ShadeTriangle {
-    std::uint32_t v[3];  ///< vertex indices
+  struct alignas(32) ShadeTriangle {  ///< 32 bytes: the 8-lane path loads one per register
     Eigen::Vector3f ng;  ///< unit face normal (0 for a degenerate triangle)
+    std::uint32_t v[3];  ///< vertex indices
   };
   struct ShadeMesh {
     std::vector<ShadeVertex> vertices;
@@ -212,6 +260,9 @@ class Scene {
   std::vector<SceneMesh> meshes_;
   std::vector<ShadeMesh> shade_;  ///< shade_[g] mirrors meshes_[g]
   std::vector<MaterialData> materials_;
+  /// Per material, for radiance8Avx2: Oren–Nayar on (1/0), A and B.
+  std::vector<int> oren_nayar_;
+  std::vector<float> on_a_, on_b_;
   std::vector<DirectLight> direct_;
   float sky_radiance_ = 0.0f;
   bool indirect_on_ = false;

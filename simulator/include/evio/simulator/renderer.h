@@ -107,6 +107,14 @@ class Renderer {
   /// The AVX2 copy's albedo pass (renderer.cpp).
   template <class Shaded, class Footprint>
   void albedoPassAvx2(std::size_t rays, const Shaded& shaded, const Footprint& footprint, Scratch* scratch) const;
+  /// The AVX2 copy's shading without supersampling (renderer_avx2.cpp):
+  /// surface, albedo, lights, occlusion and radiance of the tile's rays
+  /// eight at a time, into scratch->radiance and scratch->columns; returns
+  /// the number of occlusion rays traced.
+  std::uint64_t shadePacketsAvx2(std::size_t rays, float footprint_scale, Scratch* scratch) const;
+  /// The output images of a tile from shadePacketsAvx2's results.
+  void writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
+                    const Scratch& scratch) const;
   /// The body of both, inlined into each.
   template <bool kAvx2>
   void shadeTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,

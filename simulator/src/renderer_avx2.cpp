@@ -1,0 +1,179 @@
+// The renderer's 8-lane shading (AVX2, chosen at run time; renderer.h): the
+// tile's rays go through Scene's 8-lane surface, texture, light and
+// radiance functions, which equal the scalar ones bit for bit, so the images
+// are those of the baseline path (test:
+// Renderer.Avx2PathRendersTheSameBitsAsTheBaselinePath).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "evio/core/error.h"
+#include "evio/scenes/embree_util.h"
+#include "evio/simulator/renderer.h"
+#include "renderer_scratch.h"
+
+namespace evio::simulator {
+
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr std::size_t kLanes = 8;
+}  // namespace
+
+#if defined(__GNUC__) && defined(__x86_64__)
+__attribute__((target("avx2")))
+#endif
+std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale, Scratch* scratch) const {
+  Scratch& s = *scratch;
+  const std::size_t padded = (rays + kLanes - 1) / kLanes * kLanes;
+  const auto lights = static_cast<std::size_t>(scene_.shadowLightCount());
+  const auto hit = [&](std::size_t r) { return s.rays[r].hit.geomID != RTC_INVALID_GEOMETRY_ID; };
+
+  // Directions as columns; the last group is padded with rays that missed.
+  s.rays.resize(padded);
+  s.dx.resize(padded);
+  s.dy.resize(padded);
+  s.dz.resize(padded);
+  for (std::size_t r = 0; r < padded; ++r) {
+    if (r >= rays) {
+      scenes::setRayHit(s.rays[r], Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
+      s.dx[r] = 0.0f;
+      s.dy[r] = 0.0f;
+      s.dz[r] = 1.0f;
+      continue;
+    }
+    s.dx[r] = s.dirs[r].x();
+    s.dy[r] = s.dirs[r].y();
+    s.dz[r] = s.dirs[r].z();
+  }
+
+  // Surface points.
+  s.columns.resize(padded);
+  for (std::size_t at = 0; at < padded; at += kLanes)
+    scene_.surfaceHits8Avx2(s.rays.data(), s.dx.data(), s.dy.data(), s.dz.data(), at, &s.columns);
+  const scenes::SurfaceHitColumns& c = s.columns;
+
+  // Albedo: footprints (as the scalar path), the hits grouped by material.
+  const auto materials = static_cast<std::size_t>(scene_.materialCount());
+  s.footprint.resize(padded);
+  s.material.assign(padded, 0);
+  s.albedo.assign(padded, 0.0f);
+  s.by_material.resize(padded);
+  s.material_start.assign(materials + 1, 0);
+  for (std::size_t r = 0; r < rays; ++r) {
+    if (!hit(r)) continue;
+    const Eigen::Vector3f n(c.nx[r], c.ny[r], c.nz[r]);
+    const float cos_view = std::max(-n.dot(s.dirs[r]), 0.2f);
+    s.footprint[r] = s.rays[r].ray.tfar * footprint_scale / cos_view;
+    s.material[r] = scene_.materialOf(c.mesh[r]);
+    ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
+  }
+  for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
+  s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
+  for (std::size_t r = 0; r < rays; ++r)
+    if (hit(r)) s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
+  alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], albedo[8];
+  for (std::size_t m = 0; m < materials; ++m) {
+    const std::uint32_t end = s.material_start[m + 1];
+    for (std::uint32_t i = s.material_start[m]; i < end; i += kLanes) {
+      const std::uint32_t n = std::min<std::uint32_t>(kLanes, end - i);
+      for (std::uint32_t k = 0; k < kLanes; ++k) {  // a short group repeats its last hit
+        const std::uint32_t r = s.by_material[i + std::min(k, n - 1)];
+        px[k] = c.px[r];
+        py[k] = c.py[r];
+        pz[k] = c.pz[r];
+        u[k] = c.u[r];
+        v[k] = c.v[r];
+        fp[k] = s.footprint[r];
+      }
+      scene_.albedo8Avx2(static_cast<int>(m), px, py, pz, u, v, fp, albedo);
+      for (std::uint32_t k = 0; k < n; ++k) s.albedo[s.by_material[i + k]] = albedo[k];
+    }
+  }
+
+  // Light samples and occlusion rays (light by light).
+  s.light_columns.resize(lights);
+  s.shadow.resize(padded * lights);
+  s.shadow_slot.resize(padded * lights);
+  std::size_t shadows = 0;
+  alignas(32) float ox[8], oy[8], oz[8], t_far[8];
+  for (std::size_t k = 0; k < lights; ++k) {
+    scenes::LightColumns& lc = s.light_columns[k];
+    lc.resize(padded);
+    for (std::size_t at = 0; at < padded; at += kLanes) {
+      int need = scene_.shadowRays8Avx2(static_cast<int>(k), c, at, &lc, ox, oy, oz, t_far);
+      for (std::size_t j = 0; j < kLanes; ++j) {
+        const std::size_t r = at + j;
+        if (!hit(r)) {
+          need &= ~(1 << j);
+          lc.e[r] = 0.0f;
+        }
+      }
+      for (; need != 0; need &= need - 1) {
+        const int j = __builtin_ctz(static_cast<unsigned>(need));
+        const std::size_t r = at + static_cast<std::size_t>(j);
+        scenes::setRay(s.shadow[shadows], Eigen::Vector3f(ox[j], oy[j], oz[j]),
+                       Eigen::Vector3f(lc.wx[r], lc.wy[r], lc.wz[r]), 0.0f, t_far[j]);
+        s.shadow_slot[shadows++] = static_cast<std::uint32_t>(k * padded + r);
+      }
+    }
+  }
+  if (shadows > 0) {
+    RTCIntersectContext coherent = scenes::intersectContext(true);
+    rtcOccluded1M(scene_.embree(), &coherent, s.shadow.data(), static_cast<unsigned>(shadows), sizeof(RTCRay));
+  }
+  for (std::size_t i = 0; i < shadows; ++i)
+    if (s.shadow[i].tfar < 0.0f) {  // occluded: tfar = -inf
+      const std::uint32_t slot = s.shadow_slot[i];
+      s.light_columns[slot / padded].e[slot % padded] = 0.0f;
+    }
+
+  // Radiance; rays that left the scene see the sky (or nothing).
+  s.radiance.resize(padded);
+  for (std::size_t at = 0; at < padded; at += kLanes)
+    scene_.radiance8Avx2(c, s.material.data(), s.dx.data(), s.dy.data(), s.dz.data(), s.albedo.data(),
+                         s.light_columns.data(), at, s.radiance.data());
+  for (std::size_t r = 0; r < rays; ++r)
+    if (!hit(r))
+      s.radiance[r] = s.rays[r].ray.tnear <= s.rays[r].ray.tfar ? scene_.background(s.dirs[r]) : 0.0f;
+  s.rays.resize(rays);
+  return shadows;
+}
+
+void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
+                            const Scratch& s) const {
+  const int w = camera_.width();
+  std::size_t ri = 0;
+  for (int y = y0; y < y1; ++y) {
+    float* radiance = out->radiance.ptr<float>(y);
+    float* depth = out->depth.ptr<float>(y);
+    cv::Vec3f* normal = out->normal.ptr<cv::Vec3f>(y);
+    cv::Vec2f* flow = velocity ? out->flow.ptr<cv::Vec2f>(y) : nullptr;
+    for (int x = x0; x < x1; ++x, ++ri) {
+      const Eigen::Vector3f& b = bearings_[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+      if (std::isnan(b.x())) {
+        radiance[x] = 0.0f;
+        depth[x] = kNaN;
+        normal[x] = cv::Vec3f(0.0f, 0.0f, 0.0f);
+        if (flow) flow[x] = cv::Vec2f(kNaN, kNaN);
+        continue;
+      }
+      float sum = 0.0f;  // as the scalar path's sum over one ray (0 + −0 = +0)
+      sum += s.radiance[ri];
+      radiance[x] = sum;
+      const bool hit = s.rays[ri].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      const float range = s.rays[ri].ray.tfar;
+      depth[x] = hit ? range * b.z() : kInf;
+      normal[x] = hit ? cv::Vec3f(s.columns.nx[ri], s.columns.ny[ri], s.columns.nz[ri]) : cv::Vec3f(0.0f, 0.0f, 0.0f);
+      if (flow) {
+        Vec2 f;
+        const Vec3 bd = b.cast<double>();
+        const bool ok = hit ? pointFlow(camera_, bd * static_cast<double>(range), *velocity, &f)
+                            : directionFlow(camera_, bd, *velocity, &f);
+        flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
+      }
+    }
+  }
+}
+
+}  // namespace evio::simulator

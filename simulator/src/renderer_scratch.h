@@ -1,0 +1,41 @@
+#pragma once
+// Private to the simulator module: the per-thread buffers of one tile,
+// reused from tile to tile (renderer.cpp, renderer_avx2.cpp).
+
+#include <embree3/rtcore.h>
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "evio/scenes/scene.h"
+#include "evio/simulator/renderer.h"
+
+namespace evio::simulator {
+
+/// Per-thread buffers of one tile, reused from tile to tile.
+struct Renderer::Scratch {
+  std::vector<RTCRayHit> rays;
+  std::vector<Eigen::Vector3f> dirs;
+  std::vector<scenes::SurfaceHit> hits;
+  std::vector<float> albedo;
+  std::vector<scenes::LightSample> light;
+  std::vector<RTCRay> shadow;
+  std::vector<std::uint32_t> shadow_slot;
+  // The AVX2 albedo pass: footprints, materials, and the shaded rays
+  // grouped by material.
+  std::vector<float> footprint;
+  std::vector<int> material;
+  std::vector<std::uint32_t> by_material;
+  std::vector<std::uint32_t> material_start;  ///< first entry of each material in by_material (+ the end)
+  std::vector<std::uint32_t> material_fill;
+  // The 8-lane path (renderer_avx2.cpp): directions, hits and light samples
+  // as columns, and the radiance of each ray.
+  std::vector<float> dx, dy, dz;
+  scenes::SurfaceHitColumns columns;
+  std::vector<scenes::LightColumns> light_columns;
+  std::vector<float> radiance;
+};
+
+}  // namespace evio::simulator

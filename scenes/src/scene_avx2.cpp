@@ -76,7 +76,7 @@ EVIO_AVX2 void Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, c
   // each, then transposed into columns; a lane whose ray missed reads zeros.
   alignas(32) static const float kZeros[8] = {};
   __m256 tri[8], vert[3][8];
-  alignas(32) float bu[8], bv[8];
+  float bu[8], bv[8];
   int hit = 0;
   for (int j = 0; j < 8; ++j) {
     const RTCRayHit& q = rays[at + static_cast<std::size_t>(j)];
@@ -99,7 +99,9 @@ EVIO_AVX2 void Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, c
   if (hit == 0) return;
   transpose8(tri);  // ng x, y, z, then the indices
   for (auto& v : vert) transpose8(v);  // p x, y, z, n x, y, z, uv u, v
-  const __m256 u = _mm256_load_ps(bu), v = _mm256_load_ps(bv);
+  // Built from the scalars (a wide reload of eight scalar stores would stall).
+  const __m256 u = _mm256_setr_ps(bu[0], bu[1], bu[2], bu[3], bu[4], bu[5], bu[6], bu[7]);
+  const __m256 v = _mm256_setr_ps(bv[0], bv[1], bv[2], bv[3], bv[4], bv[5], bv[6], bv[7]);
   const __m256 w0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), u), v);
   const auto interpolate = [&](int field) EVIO_AVX2_LAMBDA {
     return blend3(w0, vert[0][field], u, vert[1][field], v, vert[2][field]);

@@ -4,6 +4,7 @@
 // are those of the baseline path (test:
 // Renderer.Avx2PathRendersTheSameBitsAsTheBaselinePath).
 #include <algorithm>
+#include <cstddef>
 #include <cmath>
 #include <limits>
 
@@ -11,6 +12,10 @@
 #include "evio/scenes/embree_util.h"
 #include "evio/simulator/renderer.h"
 #include "renderer_scratch.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 namespace evio::simulator {
 
@@ -21,8 +26,41 @@ constexpr std::size_t kLanes = 8;
 }  // namespace
 
 #if defined(__GNUC__) && defined(__x86_64__)
-__attribute__((target("avx2")))
+#define EVIO_RENDER_AVX2 __attribute__((target("avx2")))
+#else
+#define EVIO_RENDER_AVX2
 #endif
+
+#if defined(__GNUC__) && defined(__x86_64__)
+namespace {
+/// footprint[r]: the pixel's size on the surface (m) as the scalar path
+/// computes it, tfar · scale / max(−n·d, 0.2), eight rays at a time
+/// (meaningless where the ray missed).
+EVIO_RENDER_AVX2 void footprints8(std::size_t padded, float footprint_scale, const RTCRayHit* rays,
+                                  const scenes::SurfaceHitColumns& c, const float* dx, const float* dy,
+                                  const float* dz, float* footprint) {
+  constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
+  constexpr int kTfar = offsetof(RTCRay, tfar) / sizeof(float);
+  static_assert(sizeof(RTCRayHit) % sizeof(float) == 0 && offsetof(RTCRayHit, ray) == 0, "RTCRayHit layout");
+  const __m256i index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
+  const __m256 scale = _mm256_set1_ps(footprint_scale), min_cos = _mm256_set1_ps(0.2f);
+  for (std::size_t at = 0; at < padded; at += kLanes) {
+    const __m256 t_far = _mm256_i32gather_ps(reinterpret_cast<const float*>(rays + at) + kTfar, index, 4);
+    // n·d = n_x d_x + (n_y d_y + n_z d_z), as Eigen's dot.
+    const __m256 nd = _mm256_add_ps(
+        _mm256_mul_ps(_mm256_loadu_ps(c.nx.data() + at), _mm256_loadu_ps(dx + at)),
+        _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(c.ny.data() + at), _mm256_loadu_ps(dy + at)),
+                      _mm256_mul_ps(_mm256_loadu_ps(c.nz.data() + at), _mm256_loadu_ps(dz + at))));
+    const __m256 cos_view = _mm256_xor_ps(nd, _mm256_set1_ps(-0.0f));
+    // std::max(cos_view, 0.2f) = cos_view < 0.2 ? 0.2 : cos_view
+    const __m256 clamped = _mm256_blendv_ps(cos_view, min_cos, _mm256_cmp_ps(cos_view, min_cos, _CMP_LT_OQ));
+    _mm256_storeu_ps(footprint + at, _mm256_div_ps(_mm256_mul_ps(t_far, scale), clamped));
+  }
+}
+}  // namespace
+#endif
+
+EVIO_RENDER_AVX2
 std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale, Scratch* scratch) const {
   Scratch& s = *scratch;
   const std::size_t padded = (rays + kLanes - 1) / kLanes * kLanes;
@@ -60,18 +98,27 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   s.albedo.assign(padded, 0.0f);
   s.by_material.resize(padded);
   s.material_start.assign(materials + 1, 0);
+  footprints8(padded, footprint_scale, s.rays.data(), c, s.dx.data(), s.dy.data(), s.dz.data(), s.footprint.data());
+  bool one_material = true;
+  int first_material = -1;
   for (std::size_t r = 0; r < rays; ++r) {
     if (!hit(r)) continue;
-    const Eigen::Vector3f n(c.nx[r], c.ny[r], c.nz[r]);
-    const float cos_view = std::max(-n.dot(s.dirs[r]), 0.2f);
-    s.footprint[r] = s.rays[r].ray.tfar * footprint_scale / cos_view;
     s.material[r] = scene_.materialOf(c.mesh[r]);
+    if (first_material < 0) first_material = s.material[r];
+    one_material = one_material && s.material[r] == first_material;
     ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
   }
   for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
-  s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
-  for (std::size_t r = 0; r < rays; ++r)
-    if (hit(r)) s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
+  if (one_material) {  // the common case: no sorting needed
+    std::uint32_t i = 0;
+    for (std::size_t r = 0; r < rays; ++r)
+      if (hit(r)) s.by_material[i++] = static_cast<std::uint32_t>(r);
+  } else {
+    s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
+    for (std::size_t r = 0; r < rays; ++r)
+      if (hit(r))
+        s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
+  }
   alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], albedo[8];
   for (std::size_t m = 0; m < materials; ++m) {
     const std::uint32_t end = s.material_start[m + 1];

@@ -70,7 +70,7 @@ EVIO_AVX2_INLINE void transpose8(__m256 (&r)[8]) {
   r[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
 }
 
-EVIO_AVX2 void Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz,
+EVIO_AVX2 int Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz,
                                        std::size_t at, SurfaceHitColumns* out) const {
   // Each lane's triangle record and its three vertex records, one register
   // each, then transposed into columns; a lane whose ray missed reads zeros.
@@ -96,7 +96,7 @@ EVIO_AVX2 void Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, c
     out->mesh[at + static_cast<std::size_t>(j)] = q.hit.geomID;
     out->prim[at + static_cast<std::size_t>(j)] = q.hit.primID;
   }
-  if (hit == 0) return;
+  if (hit == 0) return 0;
   transpose8(tri);  // ng x, y, z, then the indices
   for (auto& v : vert) transpose8(v);  // p x, y, z, n x, y, z, uv u, v
   // Built from the scalars (a wide reload of eight scalar stores would stall).
@@ -128,6 +128,7 @@ EVIO_AVX2 void Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, c
   _mm256_storeu_ps(out->v.data() + at, interpolate(7));
   _mm256_storeu_ps(out->b1.data() + at, u);
   _mm256_storeu_ps(out->b2.data() + at, v);
+  return hit;
 }
 
 EVIO_AVX2 int Scene::shadowRays8Avx2(int k, const SurfaceHitColumns& hits, std::size_t at, LightColumns* light,
@@ -185,7 +186,7 @@ EVIO_AVX2 int Scene::shadowRays8Avx2(int k, const SurfaceHitColumns& hits, std::
 
 EVIO_AVX2 void Scene::radiance8Avx2(const SurfaceHitColumns& hits, const int* material, const float* dx,
                                     const float* dy, const float* dz, const float* albedo, const LightColumns* lights,
-                                    std::size_t at, float* out) const {
+                                    std::size_t at, int lanes, float* out) const {
   constexpr float kInvPi = 0.318309886183790671538f;
   const __m256 zero = _mm256_setzero_ps(), inv_pi = _mm256_set1_ps(kInvPi);
   const __m256i m = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(material + at));
@@ -217,11 +218,11 @@ EVIO_AVX2 void Scene::radiance8Avx2(const SurfaceHitColumns& hits, const int* ma
     alignas(32) float v0[8], v1[8], v2[8];
     for (int j = 0; j < 8; ++j) {
       const std::size_t r = at + static_cast<std::size_t>(j);
-      const auto& values = indirect_[hits.mesh[r]];
-      if (values.empty()) {
+      if (!((lanes >> j) & 1) || indirect_[hits.mesh[r]].empty()) {
         v0[j] = v1[j] = v2[j] = 0.0f;
         continue;
       }
+      const auto& values = indirect_[hits.mesh[r]];
       const std::uint32_t* t = shade_[hits.mesh[r]].triangles[hits.prim[r]].v;
       v0[j] = values[t[0]];
       v1[j] = values[t[1]];
@@ -232,7 +233,8 @@ EVIO_AVX2 void Scene::radiance8Avx2(const SurfaceHitColumns& hits, const int* ma
                    _mm256_load_ps(v1), b2, _mm256_load_ps(v2));
     // A mesh without values gives exactly 0 in the scalar code (not 0 · x).
     for (int j = 0; j < 8; ++j)
-      if (indirect_[hits.mesh[at + static_cast<std::size_t>(j)]].empty()) reinterpret_cast<float*>(&e_amb)[j] = 0.0f;
+      if (((lanes >> j) & 1) && indirect_[hits.mesh[at + static_cast<std::size_t>(j)]].empty())
+        reinterpret_cast<float*>(&e_amb)[j] = 0.0f;
   } else {
     e_amb = _mm256_mul_ps(_mm256_set1_ps(std::numbers::pi_v<float> * sky_radiance_ * 0.5f),
                           _mm256_add_ps(_mm256_set1_ps(1.0f), n.z));
@@ -243,7 +245,7 @@ EVIO_AVX2 void Scene::radiance8Avx2(const SurfaceHitColumns& hits, const int* ma
 }
 
 #else
-void Scene::surfaceHits8Avx2(const RTCRayHit*, const float*, const float*, const float*, std::size_t,
+int Scene::surfaceHits8Avx2(const RTCRayHit*, const float*, const float*, const float*, std::size_t,
                              SurfaceHitColumns*) const {
   throw Error("Scene::surfaceHits8Avx2: this build has no AVX2 path");
 }
@@ -252,7 +254,7 @@ int Scene::shadowRays8Avx2(int, const SurfaceHitColumns&, std::size_t, LightColu
   throw Error("Scene::shadowRays8Avx2: this build has no AVX2 path");
 }
 void Scene::radiance8Avx2(const SurfaceHitColumns&, const int*, const float*, const float*, const float*,
-                          const float*, const LightColumns*, std::size_t, float*) const {
+                          const float*, const LightColumns*, std::size_t, int, float*) const {
   throw Error("Scene::radiance8Avx2: this build has no AVX2 path");
 }
 #endif

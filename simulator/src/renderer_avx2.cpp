@@ -65,7 +65,7 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   Scratch& s = *scratch;
   const std::size_t padded = (rays + kLanes - 1) / kLanes * kLanes;
   const auto lights = static_cast<std::size_t>(scene_.shadowLightCount());
-  const auto hit = [&](std::size_t r) { return s.rays[r].hit.geomID != RTC_INVALID_GEOMETRY_ID; };
+  const auto hit = [&](std::size_t r) { return (s.hit_mask[r / kLanes] >> (r % kLanes)) & 1; };
 
   // Directions as columns; the last group is padded with rays that missed.
   s.rays.resize(padded);
@@ -87,8 +87,10 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
 
   // Surface points.
   s.columns.resize(padded);
+  s.hit_mask.resize(padded / kLanes);
   for (std::size_t at = 0; at < padded; at += kLanes)
-    scene_.surfaceHits8Avx2(s.rays.data(), s.dx.data(), s.dy.data(), s.dz.data(), at, &s.columns);
+    s.hit_mask[at / kLanes] = static_cast<std::uint8_t>(
+        scene_.surfaceHits8Avx2(s.rays.data(), s.dx.data(), s.dy.data(), s.dz.data(), at, &s.columns));
   const scenes::SurfaceHitColumns& c = s.columns;
 
   // Albedo: footprints (as the scalar path), the hits grouped by material.
@@ -148,14 +150,11 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
     scenes::LightColumns& lc = s.light_columns[k];
     lc.resize(padded);
     for (std::size_t at = 0; at < padded; at += kLanes) {
-      int need = scene_.shadowRays8Avx2(static_cast<int>(k), c, at, &lc, ox, oy, oz, t_far);
-      for (std::size_t j = 0; j < kLanes; ++j) {
-        const std::size_t r = at + j;
-        if (!hit(r)) {
-          need &= ~(1 << j);
-          lc.e[r] = 0.0f;
-        }
-      }
+      const int hits = s.hit_mask[at / kLanes];
+      int need = scene_.shadowRays8Avx2(static_cast<int>(k), c, at, &lc, ox, oy, oz, t_far) & hits;
+      if (hits != 0xff)
+        for (std::size_t j = 0; j < kLanes; ++j)
+          if (!((hits >> j) & 1)) lc.e[at + j] = 0.0f;
       for (; need != 0; need &= need - 1) {
         const int j = __builtin_ctz(static_cast<unsigned>(need));
         const std::size_t r = at + static_cast<std::size_t>(j);
@@ -178,8 +177,9 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   // Radiance; rays that left the scene see the sky (or nothing).
   s.radiance.resize(padded);
   for (std::size_t at = 0; at < padded; at += kLanes)
-    scene_.radiance8Avx2(c, s.material.data(), s.dx.data(), s.dy.data(), s.dz.data(), s.albedo.data(),
-                         s.light_columns.data(), at, s.radiance.data());
+    if (const int lanes = s.hit_mask[at / kLanes]; lanes != 0)
+      scene_.radiance8Avx2(c, s.material.data(), s.dx.data(), s.dy.data(), s.dz.data(), s.albedo.data(),
+                           s.light_columns.data(), at, lanes, s.radiance.data());
   for (std::size_t r = 0; r < rays; ++r)
     if (!hit(r))
       s.radiance[r] = s.rays[r].ray.tnear <= s.rays[r].ray.tfar ? scene_.background(s.dirs[r]) : 0.0f;
@@ -208,7 +208,7 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
       float sum = 0.0f;  // as the scalar path's sum over one ray (0 + −0 = +0)
       sum += s.radiance[ri];
       radiance[x] = sum;
-      const bool hit = s.rays[ri].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      const bool hit = (s.hit_mask[ri / kLanes] >> (ri % kLanes)) & 1;
       const float range = s.rays[ri].ray.tfar;
       depth[x] = hit ? range * b.z() : kInf;
       normal[x] = hit ? cv::Vec3f(s.columns.nx[ri], s.columns.ny[ri], s.columns.nz[ri]) : cv::Vec3f(0.0f, 0.0f, 0.0f);

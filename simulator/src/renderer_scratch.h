@@ -36,6 +36,7 @@ struct Renderer::Scratch {
   scenes::SurfaceHitColumns columns;
   std::vector<scenes::LightColumns> light_columns;
   std::vector<float> radiance;
+  std::vector<std::uint8_t> hit_mask;  ///< per group of eight rays: bit j = ray 8 g + j hit a surface
 };
 
 }  // namespace evio::simulator

@@ -177,8 +177,9 @@ class Scene {
   // with AVX2. Test: Renderer.Avx2PathRendersTheSameBitsAsTheBaselinePath.
 
   /// surfaceHit() of rays[at .. at + 8) whose directions are (dx, dy, dz);
-  /// lanes whose ray missed (geomID invalid) are left as they are.
-  void surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz, std::size_t at,
+  /// returns the mask of lanes whose ray hit (bit j = lane j); the others'
+  /// entries are meaningless.
+  int surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz, std::size_t at,
                         SurfaceHitColumns* hits) const;
   /// shadowRay(k, ·) of eight hits: the light sample (direction, and the
   /// irradiance, 0 where shadowRay returns false), the ray origin and t_far;
@@ -187,9 +188,10 @@ class Scene {
                       float* oy, float* oz, float* t_far) const;
   /// radiance() of eight hits seen along (dx, dy, dz) (to_viewer = −d),
   /// given their material indices, albedos and one LightColumns per shadow
-  /// light.
+  /// light; only the lanes in mask `lanes` are hits (the others' results are
+  /// meaningless).
   void radiance8Avx2(const SurfaceHitColumns& hits, const int* material, const float* dx, const float* dy,
-                     const float* dz, const float* albedo, const LightColumns* lights, std::size_t at,
+                     const float* dz, const float* albedo, const LightColumns* lights, std::size_t at, int lanes,
                      float* out) const;
 
   /// Number of lights that need an occlusion ray (sun, point, spot).

@@ -55,43 +55,41 @@ MipMap::MipMap(const cv::Mat& image, bool repeat) : repeat_(repeat) {
 
 #if defined(EVIO_SCENES_AVX2)
 namespace {
-/// Per-lane level parameters and bilinear lookups of MipMap::bilinear,
-/// eight lanes at a time; `ok` collects the lanes that stayed inside their
-/// level (the others are recomputed by the scalar lookup).
-struct Bilinear8 {
-  const float* texels;
-  const int *first, *cols, *rows;
-  const float *fcols, *frows;
-  __m256 fcols0, frows0;
-
-  EVIO_AVX2_INLINE __m256 operator()(__m256i level, __m256 s, __m256 t, __m256* ok) const {
-    const __m256 half = _mm256_set1_ps(0.5f);
-    // x = s · cols_l / cols_0 − 0.5 (texel centres at integers), as in bilinear().
-    const __m256 x = _mm256_sub_ps(_mm256_div_ps(_mm256_mul_ps(s, _mm256_i32gather_ps(fcols, level, 4)), fcols0), half);
-    const __m256 y = _mm256_sub_ps(_mm256_div_ps(_mm256_mul_ps(t, _mm256_i32gather_ps(frows, level, 4)), frows0), half);
-    const __m256 fx0 = _mm256_floor_ps(x), fy0 = _mm256_floor_ps(y);
-    const __m256 fx = _mm256_sub_ps(x, fx0), fy = _mm256_sub_ps(y, fy0);
-    const __m256i x0 = _mm256_cvttps_epi32(fx0), y0 = _mm256_cvttps_epi32(fy0);
-    const __m256i nc = _mm256_i32gather_epi32(cols, level, 4), nr = _mm256_i32gather_epi32(rows, level, 4);
-    const __m256i one = _mm256_set1_epi32(1);
-    // Inside: x0 >= 0, x0 + 1 < cols, y0 >= 0, y0 + 1 < rows.
-    const __m256i neg1 = _mm256_set1_epi32(-1);
-    const __m256i in = _mm256_and_si256(
-        _mm256_and_si256(_mm256_cmpgt_epi32(x0, neg1), _mm256_cmpgt_epi32(nc, _mm256_add_epi32(x0, one))),
-        _mm256_and_si256(_mm256_cmpgt_epi32(y0, neg1), _mm256_cmpgt_epi32(nr, _mm256_add_epi32(y0, one))));
-    *ok = _mm256_and_ps(*ok, _mm256_castsi256_ps(in));
-    // Texel (x0, y0) of the level; outside lanes read texel 0.
-    const __m256i i00 = _mm256_and_si256(
-        in, _mm256_add_epi32(_mm256_i32gather_epi32(first, level, 4),
-                             _mm256_add_epi32(_mm256_mullo_epi32(y0, nc), x0)));
-    const __m256i i10 = _mm256_and_si256(in, _mm256_add_epi32(i00, nc));
-    const __m256 r00 = _mm256_i32gather_ps(texels, i00, 4), r01 = _mm256_i32gather_ps(texels + 1, i00, 4);
-    const __m256 r10 = _mm256_i32gather_ps(texels, i10, 4), r11 = _mm256_i32gather_ps(texels + 1, i10, 4);
-    const __m256 a = avx2::lerp(r00, r01, fx);
-    const __m256 b = avx2::lerp(r10, r11, fx);
-    return avx2::lerp(a, b, fy);
-  }
+/// One level's parameters per lane: columns and rows (as int and float)
+/// and the index of its first texel in the flat buffer.
+struct LevelParams {
+  __m256 fcols, frows;
+  __m256i cols, rows, first;
 };
+
+/// The bilinear lookups of MipMap::bilinear, eight lanes at a time; `ok`
+/// collects the lanes that stayed inside their level (the others are
+/// recomputed by the scalar lookup).
+EVIO_AVX2_INLINE __m256 bilinear8(const float* texels, const LevelParams& l, __m256 fcols0, __m256 frows0, __m256 s,
+                                  __m256 t, __m256* ok) {
+  const __m256 half = _mm256_set1_ps(0.5f);
+  // x = s · cols_l / cols_0 − 0.5 (texel centres at integers), as in bilinear().
+  const __m256 x = _mm256_sub_ps(_mm256_div_ps(_mm256_mul_ps(s, l.fcols), fcols0), half);
+  const __m256 y = _mm256_sub_ps(_mm256_div_ps(_mm256_mul_ps(t, l.frows), frows0), half);
+  const __m256 fx0 = _mm256_floor_ps(x), fy0 = _mm256_floor_ps(y);
+  const __m256 fx = _mm256_sub_ps(x, fx0), fy = _mm256_sub_ps(y, fy0);
+  const __m256i x0 = _mm256_cvttps_epi32(fx0), y0 = _mm256_cvttps_epi32(fy0);
+  const __m256i one = _mm256_set1_epi32(1), neg1 = _mm256_set1_epi32(-1);
+  // Inside: x0 >= 0, x0 + 1 < cols, y0 >= 0, y0 + 1 < rows.
+  const __m256i in = _mm256_and_si256(
+      _mm256_and_si256(_mm256_cmpgt_epi32(x0, neg1), _mm256_cmpgt_epi32(l.cols, _mm256_add_epi32(x0, one))),
+      _mm256_and_si256(_mm256_cmpgt_epi32(y0, neg1), _mm256_cmpgt_epi32(l.rows, _mm256_add_epi32(y0, one))));
+  *ok = _mm256_and_ps(*ok, _mm256_castsi256_ps(in));
+  // Texel (x0, y0) of the level; outside lanes read texel 0.
+  const __m256i i00 = _mm256_and_si256(in, _mm256_add_epi32(l.first, _mm256_add_epi32(_mm256_mullo_epi32(y0, l.cols), x0)));
+  const __m256i i10 = _mm256_and_si256(in, _mm256_add_epi32(i00, l.cols));
+  const __m256 r00 = _mm256_i32gather_ps(texels, i00, 4), r01 = _mm256_i32gather_ps(texels + 1, i00, 4);
+  const __m256 r10 = _mm256_i32gather_ps(texels, i10, 4), r11 = _mm256_i32gather_ps(texels + 1, i10, 4);
+  const __m256 a = avx2::lerp(r00, r01, fx);
+  const __m256 b = avx2::lerp(r10, r11, fx);
+  return avx2::lerp(a, b, fy);
+}
+
 }  // namespace
 
 EVIO_AVX2 void MipMap::sample8Avx2(const float* s_in, const float* t_in, const float* footprint, float* out) const {
@@ -111,19 +109,34 @@ EVIO_AVX2 void MipMap::sample8Avx2(const float* s_in, const float* t_in, const f
   // A single lookup at level 0 (fine) or at the top level (l0 = top).
   const __m256 single =
       _mm256_or_ps(fine, _mm256_castsi256_ps(_mm256_cmpeq_epi32(level, _mm256_set1_epi32(top))));
-  const Bilinear8 bilinear8{texels_.ptr<float>(),   first_.data(), cols_.data(), rows_.data(), fcols_.data(),
-                            frows_.data(),          _mm256_set1_ps(fcols0_), _mm256_set1_ps(frows0_)};
+  // The parameters of each lane's two levels: broadcast when the eight
+  // lanes share their levels (neighbouring pixels mostly do), else gathered.
+  const __m256i next = _mm256_min_epi32(_mm256_add_epi32(level, _mm256_set1_epi32(1)), _mm256_set1_epi32(top));
+  const auto params = [this](__m256i l) EVIO_AVX2_LAMBDA {
+    const int first_level = _mm256_extract_epi32(l, 0);
+    if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(l, _mm256_set1_epi32(first_level))) == -1) {
+      const auto k = static_cast<std::size_t>(first_level);
+      return LevelParams{_mm256_set1_ps(fcols_[k]), _mm256_set1_ps(frows_[k]), _mm256_set1_epi32(cols_[k]),
+                         _mm256_set1_epi32(rows_[k]), _mm256_set1_epi32(first_[k])};
+    }
+    return LevelParams{_mm256_i32gather_ps(fcols_.data(), l, 4), _mm256_i32gather_ps(frows_.data(), l, 4),
+                       _mm256_i32gather_epi32(cols_.data(), l, 4), _mm256_i32gather_epi32(rows_.data(), l, 4),
+                       _mm256_i32gather_epi32(first_.data(), l, 4)};
+  };
+  const float* texels = texels_.ptr<float>();
+  const __m256 fcols0 = _mm256_set1_ps(fcols0_), frows0 = _mm256_set1_ps(frows0_);
   const __m256 s = _mm256_loadu_ps(s_in), t = _mm256_loadu_ps(t_in);
   __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-  const __m256 a = bilinear8(level, s, t, &ok);
-  // The next level where blending (level + 1 <= top there).
-  const __m256i next = _mm256_min_epi32(_mm256_add_epi32(level, _mm256_set1_epi32(1)), _mm256_set1_epi32(top));
-  __m256 ok_b = ok;
-  const __m256 b = bilinear8(next, s, t, &ok_b);
-  ok = _mm256_blendv_ps(ok_b, ok, single);  // the second lookup counts only where blending
-  const __m256 f = _mm256_sub_ps(lam, _mm256_cvtepi32_ps(level));
-  const __m256 r = _mm256_blendv_ps(avx2::lerp(a, b, f), a, single);
-  _mm256_storeu_ps(out, r);
+  const __m256 a = bilinear8(texels, params(level), fcols0, frows0, s, t, &ok);
+  if (_mm256_movemask_ps(single) == 0xff) {  // no lane blends: one level each
+    _mm256_storeu_ps(out, a);
+  } else {  // the next level where blending (level + 1 <= top there)
+    __m256 ok_b = ok;
+    const __m256 b = bilinear8(texels, params(next), fcols0, frows0, s, t, &ok_b);
+    ok = _mm256_blendv_ps(ok_b, ok, single);  // the second lookup counts only where blending
+    const __m256 f = _mm256_sub_ps(lam, _mm256_cvtepi32_ps(level));
+    _mm256_storeu_ps(out, _mm256_blendv_ps(avx2::lerp(a, b, f), a, single));
+  }
   const int inside = _mm256_movemask_ps(ok);
   if (inside != 0xff)
     for (int k = 0; k < 8; ++k)

@@ -101,7 +101,7 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   s.by_material.resize(padded);
   s.material_start.assign(materials + 1, 0);
   footprints8(padded, footprint_scale, s.rays.data(), c, s.dx.data(), s.dy.data(), s.dz.data(), s.footprint.data());
-  bool one_material = true;
+  bool one_material = true;  // every hit of the tile has the same material
   int first_material = -1;
   for (std::size_t r = 0; r < rays; ++r) {
     if (!hit(r)) continue;
@@ -111,32 +111,45 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
     ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
   }
   for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
-  if (one_material) {  // the common case: no sorting needed
-    std::uint32_t i = 0;
-    for (std::size_t r = 0; r < rays; ++r)
-      if (hit(r)) s.by_material[i++] = static_cast<std::uint32_t>(r);
-  } else {
+  alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], albedo[8];
+  // Eight hits of material m, rays[i] for i < n (the rest repeat the last).
+  const auto gathered = [&](int m, const std::uint32_t* rays_of, std::uint32_t n) {
+    for (std::uint32_t k = 0; k < kLanes; ++k) {
+      const std::uint32_t r = rays_of[std::min(k, n - 1)];
+      px[k] = c.px[r];
+      py[k] = c.py[r];
+      pz[k] = c.pz[r];
+      u[k] = c.u[r];
+      v[k] = c.v[r];
+      fp[k] = s.footprint[r];
+    }
+    scene_.albedo8Avx2(m, px, py, pz, u, v, fp, albedo);
+    for (std::uint32_t k = 0; k < n; ++k) s.albedo[rays_of[k]] = albedo[k];
+  };
+  if (one_material && first_material >= 0) {
+    // The common case: a group of eight hits goes to the texture as it is.
+    std::uint32_t group[8];
+    for (std::size_t at = 0; at < padded; at += kLanes) {
+      const int mask = s.hit_mask[at / kLanes];
+      if (mask == 0xff) {
+        scene_.albedo8Avx2(first_material, c.px.data() + at, c.py.data() + at, c.pz.data() + at, c.u.data() + at,
+                           c.v.data() + at, s.footprint.data() + at, s.albedo.data() + at);
+      } else if (mask != 0) {
+        std::uint32_t n = 0;
+        for (std::size_t j = 0; j < kLanes; ++j)
+          if ((mask >> j) & 1) group[n++] = static_cast<std::uint32_t>(at + j);
+        gathered(first_material, group, n);
+      }
+    }
+  } else {  // grouped by material (a counting sort, in ray order within a material)
     s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
     for (std::size_t r = 0; r < rays; ++r)
       if (hit(r))
         s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
-  }
-  alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], albedo[8];
-  for (std::size_t m = 0; m < materials; ++m) {
-    const std::uint32_t end = s.material_start[m + 1];
-    for (std::uint32_t i = s.material_start[m]; i < end; i += kLanes) {
-      const std::uint32_t n = std::min<std::uint32_t>(kLanes, end - i);
-      for (std::uint32_t k = 0; k < kLanes; ++k) {  // a short group repeats its last hit
-        const std::uint32_t r = s.by_material[i + std::min(k, n - 1)];
-        px[k] = c.px[r];
-        py[k] = c.py[r];
-        pz[k] = c.pz[r];
-        u[k] = c.u[r];
-        v[k] = c.v[r];
-        fp[k] = s.footprint[r];
-      }
-      scene_.albedo8Avx2(static_cast<int>(m), px, py, pz, u, v, fp, albedo);
-      for (std::uint32_t k = 0; k < n; ++k) s.albedo[s.by_material[i + k]] = albedo[k];
+    for (std::size_t m = 0; m < materials; ++m) {
+      const std::uint32_t end = s.material_start[m + 1];
+      for (std::uint32_t i = s.material_start[m]; i < end; i += kLanes)
+        gathered(static_cast<int>(m), s.by_material.data() + i, std::min<std::uint32_t>(kLanes, end - i));
     }
   }
 

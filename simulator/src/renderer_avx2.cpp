@@ -108,9 +108,7 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
     s.material[r] = scene_.materialOf(c.mesh[r]);
     if (first_material < 0) first_material = s.material[r];
     one_material = one_material && s.material[r] == first_material;
-    ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
   }
-  for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
   alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], albedo[8];
   // Eight hits of material m, rays[i] for i < n (the rest repeat the last).
   const auto gathered = [&](int m, const std::uint32_t* rays_of, std::uint32_t n) {
@@ -142,6 +140,9 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
       }
     }
   } else {  // grouped by material (a counting sort, in ray order within a material)
+    for (std::size_t r = 0; r < rays; ++r)
+      if (hit(r)) ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
+    for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
     s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
     for (std::size_t r = 0; r < rays; ++r)
       if (hit(r))

@@ -47,6 +47,11 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
               unprojectOrNan(camera_, Vec2(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5));
     }
   pixel_angle_rad_ = static_cast<float>(1.0 / camera_.intrinsics()[0]);
+  bearing_columns_[0].resize(bearings_.size());
+  bearing_columns_[1].resize(bearings_.size());
+  bearing_columns_[2].resize(bearings_.size());
+  for (std::size_t p = 0; p < bearings_.size(); ++p)
+    for (int i = 0; i < 3; ++i) bearing_columns_[static_cast<std::size_t>(i)][p] = bearings_[p][i];
 #if defined(EVIO_RENDER_AVX2)
   __builtin_cpu_init();
   avx2_ = options_.avx2 && __builtin_cpu_supports("avx2") != 0;
@@ -174,7 +179,13 @@ template <bool kAvx2>
   s.shadow_slot.resize(rays * lights);
 
   std::size_t ri = 0;
-  for (int y = y0; y < y1; ++y)
+  if constexpr (kAvx2) {
+    if (!super) {  // eight rays at a time (renderer_avx2.cpp)
+      counts->camera_rays = setupRaysAvx2(x0, y0, x1, y1, R, org, scratch);
+      ri = rays;
+    }
+  }
+  for (int y = y0; y < y1 && ri < rays; ++y)
     for (int x = x0; x < x1; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
       for (int k = 0; k < per_pixel; ++k, ++ri) {

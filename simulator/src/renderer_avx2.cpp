@@ -33,6 +33,12 @@ constexpr std::size_t kLanes = 8;
 
 #if defined(__GNUC__) && defined(__x86_64__)
 namespace {
+/// A lane mask: lane k set where its argument is 1.
+__attribute__((target("avx2"), always_inline)) inline __m256 lanes(int a, int b, int c, int d, int e, int f, int g,
+                                                                  int h) {
+  return _mm256_castsi256_ps(_mm256_setr_epi32(-a, -b, -c, -d, -e, -f, -g, -h));
+}
+
 /// footprint[r]: the pixel's size on the surface (m) as the scalar path
 /// computes it, tfar · scale / max(−n·d, 0.2), eight rays at a time
 /// (meaningless where the ray missed).
@@ -67,23 +73,11 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   const auto lights = static_cast<std::size_t>(scene_.shadowLightCount());
   const auto hit = [&](std::size_t r) { return (s.hit_mask[r / kLanes] >> (r % kLanes)) & 1; };
 
-  // Directions as columns; the last group is padded with rays that missed.
+  // The last group is padded with rays that missed (setupRaysAvx2 sized the
+  // direction columns).
   s.rays.resize(padded);
-  s.dx.resize(padded);
-  s.dy.resize(padded);
-  s.dz.resize(padded);
-  for (std::size_t r = 0; r < padded; ++r) {
-    if (r >= rays) {
-      scenes::setRayHit(s.rays[r], Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
-      s.dx[r] = 0.0f;
-      s.dy[r] = 0.0f;
-      s.dz[r] = 1.0f;
-      continue;
-    }
-    s.dx[r] = s.dirs[r].x();
-    s.dy[r] = s.dirs[r].y();
-    s.dz[r] = s.dirs[r].z();
-  }
+  for (std::size_t r = rays; r < padded; ++r)
+    scenes::setRayHit(s.rays[r], Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
 
   // Surface points.
   s.columns.resize(padded);
@@ -196,43 +190,162 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
                            s.light_columns.data(), at, lanes, s.radiance.data());
   for (std::size_t r = 0; r < rays; ++r)
     if (!hit(r))
-      s.radiance[r] = s.rays[r].ray.tnear <= s.rays[r].ray.tfar ? scene_.background(s.dirs[r]) : 0.0f;
+      s.radiance[r] = s.rays[r].ray.tnear <= s.rays[r].ray.tfar
+                          ? scene_.background(Eigen::Vector3f(s.dx[r], s.dy[r], s.dz[r]))
+                          : 0.0f;
   s.rays.resize(rays);
   return shadows;
 }
 
+EVIO_RENDER_AVX2
+std::uint64_t Renderer::setupRaysAvx2(int x0, int y0, int x1, int y1, const Eigen::Matrix3f& R,
+                                      const Eigen::Vector3f& org, Scratch* scratch) const {
+  Scratch& s = *scratch;
+  const std::size_t rays = static_cast<std::size_t>(x1 - x0) * static_cast<std::size_t>(y1 - y0);
+  const std::size_t padded = (rays + kLanes - 1) / kLanes * kLanes;
+  s.dx.resize(padded);
+  s.dy.resize(padded);
+  s.dz.resize(padded);
+  for (std::size_t r = rays; r < padded; ++r) {  // padding: straight up, never traced
+    s.dx[r] = 0.0f;
+    s.dy[r] = 0.0f;
+    s.dz[r] = 1.0f;
+  }
+  RTCRayHit active;  // every field but the direction
+  scenes::setRayHit(active, org, Eigen::Vector3f::UnitZ());
+  RTCRayHit inactive;  // a pixel without a ray: tnear > tfar
+  scenes::setRayHit(inactive, org, Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
+  const int w = camera_.width();
+  std::uint64_t traced = 0;
+  std::size_t ri = 0;
+  for (int y = y0; y < y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    int x = x0;
+    // d = R b, row i as Eigen evaluates it: R_i0 b_x + (R_i1 b_y + R_i2 b_z).
+    for (; x + static_cast<int>(kLanes) <= x1; x += static_cast<int>(kLanes), ri += kLanes) {
+      const std::size_t p = row + static_cast<std::size_t>(x);
+      const __m256 bx = _mm256_loadu_ps(bearing_columns_[0].data() + p);
+      const __m256 by = _mm256_loadu_ps(bearing_columns_[1].data() + p);
+      const __m256 bz = _mm256_loadu_ps(bearing_columns_[2].data() + p);
+      const __m256 none = _mm256_cmp_ps(bx, bx, _CMP_UNORD_Q);  // no ray: NaN bearing
+      float* d[3] = {s.dx.data() + ri, s.dy.data() + ri, s.dz.data() + ri};
+      for (int i = 0; i < 3; ++i) {
+        const __m256 v = _mm256_add_ps(
+            _mm256_mul_ps(_mm256_set1_ps(R(i, 0)), bx),
+            _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(R(i, 1)), by), _mm256_mul_ps(_mm256_set1_ps(R(i, 2)), bz)));
+        _mm256_storeu_ps(d[i], _mm256_blendv_ps(v, _mm256_set1_ps(i == 2 ? 1.0f : 0.0f), none));
+      }
+      const int no_ray = _mm256_movemask_ps(none);
+      for (std::size_t j = 0; j < kLanes; ++j) {
+        RTCRayHit& q = s.rays[ri + j];
+        q = (no_ray >> j) & 1 ? inactive : active;
+        q.ray.dir_x = s.dx[ri + j];
+        q.ray.dir_y = s.dy[ri + j];
+        q.ray.dir_z = s.dz[ri + j];
+      }
+      traced += kLanes - static_cast<std::uint64_t>(__builtin_popcount(static_cast<unsigned>(no_ray)));
+    }
+    for (; x < x1; ++x, ++ri) {  // the rest of the row as the scalar path
+      const Eigen::Vector3f& b = bearings_[row + static_cast<std::size_t>(x)];
+      const bool none = std::isnan(b.x());
+      const Eigen::Vector3f d = none ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f(R * b);
+      s.dx[ri] = d.x();
+      s.dy[ri] = d.y();
+      s.dz[ri] = d.z();
+      RTCRayHit& q = s.rays[ri];
+      q = none ? inactive : active;
+      q.ray.dir_x = d.x();
+      q.ray.dir_y = d.y();
+      q.ray.dir_z = d.z();
+      traced += none ? 0 : 1;
+    }
+  }
+  return traced;
+}
+
+EVIO_RENDER_AVX2
 void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
                             const Scratch& s) const {
   const int w = camera_.width();
   std::size_t ri = 0;
+  const __m256 inf = _mm256_set1_ps(kInf), nan = _mm256_set1_ps(kNaN), zero = _mm256_setzero_ps();
+  // (x, y, z) of eight pixels interleaved: lane k of output register q is
+  // component (8 q + k) mod 3 of pixel (8 q + k) / 3.
+  const __m256i pick[3] = {_mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2), _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5),
+                           _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7)};
+  // Lanes holding a y or a z component: (8 q + k) mod 3 = 1 or 2.
+  const __m256 is_y[3] = {lanes(0, 1, 0, 0, 1, 0, 0, 1), lanes(0, 0, 1, 0, 0, 1, 0, 0), lanes(1, 0, 0, 1, 0, 0, 1, 0)};
+  const __m256 is_z[3] = {lanes(0, 0, 1, 0, 0, 1, 0, 0), lanes(1, 0, 0, 1, 0, 0, 1, 0), lanes(0, 1, 0, 0, 1, 0, 0, 1)};
+  constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
+  constexpr int kTfar = offsetof(RTCRay, tfar) / sizeof(float);
+  const __m256i ray_index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
   for (int y = y0; y < y1; ++y) {
     float* radiance = out->radiance.ptr<float>(y);
     float* depth = out->depth.ptr<float>(y);
     cv::Vec3f* normal = out->normal.ptr<cv::Vec3f>(y);
     cv::Vec2f* flow = velocity ? out->flow.ptr<cv::Vec2f>(y) : nullptr;
-    for (int x = x0; x < x1; ++x, ++ri) {
-      const Eigen::Vector3f& b = bearings_[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    int x = x0;
+    for (; x + static_cast<int>(kLanes) <= x1; x += static_cast<int>(kLanes), ri += kLanes) {
+      const std::size_t p = row + static_cast<std::size_t>(x);
+      const __m256 bz = _mm256_loadu_ps(bearing_columns_[2].data() + p);
+      const __m256 none = _mm256_cmp_ps(_mm256_loadu_ps(bearing_columns_[0].data() + p),
+                                        _mm256_loadu_ps(bearing_columns_[0].data() + p), _CMP_UNORD_Q);
+      // Rays ri .. ri + 7 (a tile row need not start at a multiple of eight).
+      const std::size_t g = ri / kLanes, shift = ri % kLanes;
+      const unsigned bits = shift == 0 ? s.hit_mask[g] : ((s.hit_mask[g] | (unsigned{s.hit_mask[g + 1]} << 8)) >> shift) & 0xffu;
+      const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+      const __m256 hit = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+          _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane_bit), lane_bit));
+      const __m256 range = _mm256_i32gather_ps(reinterpret_cast<const float*>(s.rays.data() + ri) + kTfar, ray_index, 4);
+      // radiance: 0 + L (the scalar path's sum over one ray); 0 without a ray.
+      const __m256 rad = _mm256_add_ps(zero, _mm256_loadu_ps(s.radiance.data() + ri));
+      _mm256_storeu_ps(radiance + x, _mm256_blendv_ps(rad, zero, none));
+      const __m256 z = _mm256_blendv_ps(inf, _mm256_mul_ps(range, bz), hit);
+      _mm256_storeu_ps(depth + x, _mm256_blendv_ps(z, nan, none));
+      // normal: the shading normal where the ray hit, else 0 (also without a ray).
+      const __m256 keep = _mm256_andnot_ps(none, hit);
+      const __m256 n[3] = {_mm256_and_ps(keep, _mm256_loadu_ps(s.columns.nx.data() + ri)),
+                           _mm256_and_ps(keep, _mm256_loadu_ps(s.columns.ny.data() + ri)),
+                           _mm256_and_ps(keep, _mm256_loadu_ps(s.columns.nz.data() + ri))};
+      float* nrm = reinterpret_cast<float*>(normal + x);
+      for (int q = 0; q < 3; ++q) {
+        const __m256 vx = _mm256_permutevar8x32_ps(n[0], pick[q]), vy = _mm256_permutevar8x32_ps(n[1], pick[q]),
+                     vz = _mm256_permutevar8x32_ps(n[2], pick[q]);
+        const __m256 r = _mm256_blendv_ps(_mm256_blendv_ps(vx, vy, is_y[q]), vz, is_z[q]);
+        _mm256_storeu_ps(nrm + 8 * q, r);
+      }
+    }
+    for (; x < x1; ++x, ++ri) {  // the rest of the row, and every pixel's flow
+      const Eigen::Vector3f& b = bearings_[row + static_cast<std::size_t>(x)];
       if (std::isnan(b.x())) {
         radiance[x] = 0.0f;
         depth[x] = kNaN;
         normal[x] = cv::Vec3f(0.0f, 0.0f, 0.0f);
-        if (flow) flow[x] = cv::Vec2f(kNaN, kNaN);
         continue;
       }
       float sum = 0.0f;  // as the scalar path's sum over one ray (0 + −0 = +0)
       sum += s.radiance[ri];
       radiance[x] = sum;
       const bool hit = (s.hit_mask[ri / kLanes] >> (ri % kLanes)) & 1;
-      const float range = s.rays[ri].ray.tfar;
-      depth[x] = hit ? range * b.z() : kInf;
+      depth[x] = hit ? s.rays[ri].ray.tfar * b.z() : kInf;
       normal[x] = hit ? cv::Vec3f(s.columns.nx[ri], s.columns.ny[ri], s.columns.nz[ri]) : cv::Vec3f(0.0f, 0.0f, 0.0f);
-      if (flow) {
-        Vec2 f;
-        const Vec3 bd = b.cast<double>();
-        const bool ok = hit ? pointFlow(camera_, bd * static_cast<double>(range), *velocity, &f)
-                            : directionFlow(camera_, bd, *velocity, &f);
-        flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
+    }
+    if (!flow) continue;
+    const std::size_t row_start = ri - static_cast<std::size_t>(x1 - x0);
+    for (x = x0; x < x1; ++x) {
+      const std::size_t r = row_start + static_cast<std::size_t>(x - x0);
+      const Eigen::Vector3f& b = bearings_[row + static_cast<std::size_t>(x)];
+      if (std::isnan(b.x())) {
+        flow[x] = cv::Vec2f(kNaN, kNaN);
+        continue;
       }
+      const bool hit = (s.hit_mask[r / kLanes] >> (r % kLanes)) & 1;
+      Vec2 f;
+      const Vec3 bd = b.cast<double>();
+      const bool ok = hit ? pointFlow(camera_, bd * static_cast<double>(s.rays[r].ray.tfar), *velocity, &f)
+                          : directionFlow(camera_, bd, *velocity, &f);
+      flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
     }
   }
 }

@@ -17,6 +17,7 @@
 /// nothing but its own rays, so the output is bit-identical whatever the
 /// number of threads.
 
+#include <array>
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
 #include <vector>
@@ -112,6 +113,10 @@ class Renderer {
   /// eight at a time, into scratch->radiance and scratch->columns; returns
   /// the number of occlusion rays traced.
   std::uint64_t shadePacketsAvx2(std::size_t rays, float footprint_scale, Scratch* scratch) const;
+  /// The camera rays of a tile for shadePacketsAvx2 (directions also as
+  /// columns); returns the number of active rays.
+  std::uint64_t setupRaysAvx2(int x0, int y0, int x1, int y1, const Eigen::Matrix3f& R, const Eigen::Vector3f& org,
+                              Scratch* scratch) const;
   /// The output images of a tile from shadePacketsAvx2's results.
   void writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
                     const Scratch& scratch) const;
@@ -125,6 +130,7 @@ class Renderer {
   RendererOptions options_;
   std::vector<Eigen::Vector3f> bearings_;     ///< centre ray per pixel, row-major
   std::vector<Eigen::Vector3f> sub_bearings_; ///< n² rays per pixel when supersampling > 1
+  std::array<std::vector<float>, 3> bearing_columns_;  ///< bearings_ as x, y, z columns (the AVX2 path)
   float pixel_angle_rad_ = 0.0f;              ///< ≈ 1 / fx, for the texture footprint
   bool avx2_ = false;                         ///< options_.avx2 and the CPU has AVX2
 };

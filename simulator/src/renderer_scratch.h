@@ -33,6 +33,7 @@ struct Renderer::Scratch {
   // The 8-lane path (renderer_avx2.cpp): directions, hits and light samples
   // as columns, and the radiance of each ray.
   std::vector<float> dx, dy, dz;
+  std::vector<float> bz;  ///< z of the pixel's bearing in C (NaN: no ray), for the depth
   scenes::SurfaceHitColumns columns;
   std::vector<scenes::LightColumns> light_columns;
   std::vector<float> radiance;

@@ -47,15 +47,28 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
               unprojectOrNan(camera_, Vec2(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5));
     }
   pixel_angle_rad_ = static_cast<float>(1.0 / camera_.intrinsics()[0]);
-  bearing_columns_[0].resize(bearings_.size());
-  bearing_columns_[1].resize(bearings_.size());
-  bearing_columns_[2].resize(bearings_.size());
-  for (std::size_t p = 0; p < bearings_.size(); ++p)
-    for (int i = 0; i < 3; ++i) bearing_columns_[static_cast<std::size_t>(i)][p] = bearings_[p][i];
 #if defined(EVIO_RENDER_AVX2)
   __builtin_cpu_init();
   avx2_ = options_.avx2 && __builtin_cpu_supports("avx2") != 0;
 #endif
+  if (!avx2_ || n > 1) return;
+  // The bearings tile by tile for the AVX2 path without supersampling: per
+  // tile, x, y and z columns of tile_stride_ entries (rays in row-major
+  // order, NaN padding).
+  const int t = options_.tile_px;
+  const int tiles_x = (w + t - 1) / t, tiles = tiles_x * ((h + t - 1) / t);
+  tile_stride_ = (static_cast<std::size_t>(t) * static_cast<std::size_t>(t) + 7) / 8 * 8;
+  tile_bearings_.assign(static_cast<std::size_t>(tiles) * 3 * tile_stride_, kNaN);
+  for (int k = 0; k < tiles; ++k) {
+    const int x0 = (k % tiles_x) * t, y0 = (k / tiles_x) * t;
+    float* col = tile_bearings_.data() + static_cast<std::size_t>(k) * 3 * tile_stride_;
+    std::size_t ri = 0;
+    for (int y = y0; y < std::min(y0 + t, h); ++y)
+      for (int x = x0; x < std::min(x0 + t, w); ++x, ++ri) {
+        const Eigen::Vector3f& b = bearings_[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+        for (std::size_t i = 0; i < 3; ++i) col[i * tile_stride_ + ri] = b[static_cast<Eigen::Index>(i)];
+      }
+  }
 }
 
 
@@ -181,7 +194,7 @@ template <bool kAvx2>
   std::size_t ri = 0;
   if constexpr (kAvx2) {
     if (!super) {  // eight rays at a time (renderer_avx2.cpp)
-      counts->camera_rays = setupRaysAvx2(x0, y0, x1, y1, R, org, scratch);
+      counts->camera_rays = setupRaysAvx2(tile, rays, R, org, scratch);
       ri = rays;
     }
   }

@@ -76,11 +76,8 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   const auto lights = static_cast<std::size_t>(scene_.shadowLightCount());
   const auto hit = [&](std::size_t r) { return (s.hit_mask[r / kLanes] >> (r % kLanes)) & 1; };
 
-  // The last group is padded with rays that missed (setupRaysAvx2 sized the
-  // direction columns).
-  s.rays.resize(padded);
-  for (std::size_t r = rays; r < padded; ++r)
-    scenes::setRayHit(s.rays[r], Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
+  // setupRaysAvx2 padded the rays and their columns to whole groups with
+  // rays that were not traced.
 
   // Surface points.
   s.columns.resize(padded);
@@ -201,70 +198,46 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
 }
 
 EVIO_RENDER_AVX2
-std::uint64_t Renderer::setupRaysAvx2(int x0, int y0, int x1, int y1, const Eigen::Matrix3f& R,
+std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::Matrix3f& R,
                                       const Eigen::Vector3f& org, Scratch* scratch) const {
   Scratch& s = *scratch;
-  const std::size_t rays = static_cast<std::size_t>(x1 - x0) * static_cast<std::size_t>(y1 - y0);
   const std::size_t padded = (rays + kLanes - 1) / kLanes * kLanes;
+  s.rays.resize(padded);
   s.dx.resize(padded);
   s.dy.resize(padded);
   s.dz.resize(padded);
   s.bz.resize(padded);
-  for (std::size_t r = rays; r < padded; ++r) {  // padding: straight up, never traced
-    s.dx[r] = 0.0f;
-    s.dy[r] = 0.0f;
-    s.dz[r] = 1.0f;
-  }
   RTCRayHit active;  // every field but the direction
   scenes::setRayHit(active, org, Eigen::Vector3f::UnitZ());
-  RTCRayHit inactive;  // a pixel without a ray: tnear > tfar
+  RTCRayHit inactive;  // a pixel without a ray (and the padding): tnear > tfar
   scenes::setRayHit(inactive, org, Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
-  const int w = camera_.width();
+  // The tile's bearings, ray after ray (NaN: no ray; the padding too).
+  const float* bearing = tile_bearings_.data() + static_cast<std::size_t>(tile) * 3 * tile_stride_;
   std::uint64_t traced = 0;
-  std::size_t ri = 0;
-  for (int y = y0; y < y1; ++y) {
-    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-    int x = x0;
-    // d = R b, row i as Eigen evaluates it: R_i0 b_x + (R_i1 b_y + R_i2 b_z).
-    for (; x + static_cast<int>(kLanes) <= x1; x += static_cast<int>(kLanes), ri += kLanes) {
-      const std::size_t p = row + static_cast<std::size_t>(x);
-      const __m256 bx = _mm256_loadu_ps(bearing_columns_[0].data() + p);
-      const __m256 by = _mm256_loadu_ps(bearing_columns_[1].data() + p);
-      const __m256 bz = _mm256_loadu_ps(bearing_columns_[2].data() + p);
-      const __m256 none = _mm256_cmp_ps(bx, bx, _CMP_UNORD_Q);  // no ray: NaN bearing
-      _mm256_storeu_ps(s.bz.data() + ri, bz);                    // for writeOutputs
-      float* d[3] = {s.dx.data() + ri, s.dy.data() + ri, s.dz.data() + ri};
-      for (int i = 0; i < 3; ++i) {
-        const __m256 v = _mm256_add_ps(
-            _mm256_mul_ps(_mm256_set1_ps(R(i, 0)), bx),
-            _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(R(i, 1)), by), _mm256_mul_ps(_mm256_set1_ps(R(i, 2)), bz)));
-        _mm256_storeu_ps(d[i], _mm256_blendv_ps(v, _mm256_set1_ps(i == 2 ? 1.0f : 0.0f), none));
-      }
-      const int no_ray = _mm256_movemask_ps(none);
-      for (std::size_t j = 0; j < kLanes; ++j) {
-        RTCRayHit& q = s.rays[ri + j];
-        q = (no_ray >> j) & 1 ? inactive : active;
-        q.ray.dir_x = s.dx[ri + j];
-        q.ray.dir_y = s.dy[ri + j];
-        q.ray.dir_z = s.dz[ri + j];
-      }
-      traced += kLanes - static_cast<std::uint64_t>(__builtin_popcount(static_cast<unsigned>(no_ray)));
+  for (std::size_t ri = 0; ri < padded; ri += kLanes) {
+    const __m256 bx = _mm256_loadu_ps(bearing + ri);
+    const __m256 by = _mm256_loadu_ps(bearing + tile_stride_ + ri);
+    const __m256 bz = _mm256_loadu_ps(bearing + 2 * tile_stride_ + ri);
+    const __m256 none = _mm256_cmp_ps(bx, bx, _CMP_UNORD_Q);
+    _mm256_storeu_ps(s.bz.data() + ri, bz);  // for writeOutputs
+    // d = R b, row i as Eigen evaluates it: R_i0 b_x + (R_i1 b_y + R_i2 b_z);
+    // +z where there is no ray (as the scalar path).
+    float* d[3] = {s.dx.data() + ri, s.dy.data() + ri, s.dz.data() + ri};
+    for (int i = 0; i < 3; ++i) {
+      const __m256 v = _mm256_add_ps(
+          _mm256_mul_ps(_mm256_set1_ps(R(i, 0)), bx),
+          _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(R(i, 1)), by), _mm256_mul_ps(_mm256_set1_ps(R(i, 2)), bz)));
+      _mm256_storeu_ps(d[i], _mm256_blendv_ps(v, _mm256_set1_ps(i == 2 ? 1.0f : 0.0f), none));
     }
-    for (; x < x1; ++x, ++ri) {  // the rest of the row as the scalar path
-      const Eigen::Vector3f& b = bearings_[row + static_cast<std::size_t>(x)];
-      const bool none = std::isnan(b.x());
-      s.bz[ri] = b.z();
-      const Eigen::Vector3f d = none ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f(R * b);
-      s.dx[ri] = d.x();
-      s.dy[ri] = d.y();
-      s.dz[ri] = d.z();
-      RTCRayHit& q = s.rays[ri];
-      q = none ? inactive : active;
-      q.ray.dir_x = d.x();
-      q.ray.dir_y = d.y();
-      q.ray.dir_z = d.z();
-      traced += none ? 0 : 1;
+    const int no_ray = _mm256_movemask_ps(none);
+    for (std::size_t j = 0; j < kLanes; ++j) {
+      RTCRayHit& q = s.rays[ri + j];
+      q = (no_ray >> j) & 1 ? inactive : active;
+      q.ray.dir_x = s.dx[ri + j];
+      q.ray.dir_y = s.dy[ri + j];
+      q.ray.dir_z = s.dz[ri + j];
     }
+    traced += kLanes - static_cast<std::uint64_t>(__builtin_popcount(static_cast<unsigned>(no_ray)));
   }
   return traced;
 }

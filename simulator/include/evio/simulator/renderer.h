@@ -17,7 +17,6 @@
 /// nothing but its own rays, so the output is bit-identical whatever the
 /// number of threads.
 
-#include <array>
 #include <cstdint>
 #include <opencv2/core/mat.hpp>
 #include <vector>
@@ -113,9 +112,10 @@ class Renderer {
   /// eight at a time, into scratch->radiance and scratch->columns; returns
   /// the number of occlusion rays traced.
   std::uint64_t shadePacketsAvx2(std::size_t rays, float footprint_scale, Scratch* scratch) const;
-  /// The camera rays of a tile for shadePacketsAvx2 (directions also as
-  /// columns); returns the number of active rays.
-  std::uint64_t setupRaysAvx2(int x0, int y0, int x1, int y1, const Eigen::Matrix3f& R, const Eigen::Vector3f& org,
+  /// The camera rays of tile `tile` (`rays` of them) for shadePacketsAvx2,
+  /// directions also as columns, padded to whole groups of eight with rays
+  /// that are not traced; returns the number of active rays.
+  std::uint64_t setupRaysAvx2(int tile, std::size_t rays, const Eigen::Matrix3f& R, const Eigen::Vector3f& org,
                               Scratch* scratch) const;
   /// The output images of a tile from shadePacketsAvx2's results.
   void writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
@@ -130,7 +130,8 @@ class Renderer {
   RendererOptions options_;
   std::vector<Eigen::Vector3f> bearings_;     ///< centre ray per pixel, row-major
   std::vector<Eigen::Vector3f> sub_bearings_; ///< n² rays per pixel when supersampling > 1
-  std::array<std::vector<float>, 3> bearing_columns_;  ///< bearings_ as x, y, z columns (the AVX2 path)
+  std::vector<float> tile_bearings_;  ///< bearings_ tile by tile as x, y, z columns (the AVX2 path)
+  std::size_t tile_stride_ = 0;      ///< entries per column and tile: tile_px², rounded up to 8
   float pixel_angle_rad_ = 0.0f;              ///< ≈ 1 / fx, for the texture footprint
   bool avx2_ = false;                         ///< options_.avx2 and the CPU has AVX2
 };

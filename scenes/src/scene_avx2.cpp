@@ -49,25 +49,25 @@ EVIO_AVX2_INLINE void store(const V3& a, std::vector<float>& x, std::vector<floa
 
 }  // namespace
 
-/// Rows r[0..8) (one 32-byte record per lane) to columns: r[i] becomes
-/// field i of the eight records.
-EVIO_AVX2_INLINE void transpose8(__m256 (&r)[8]) {
-  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-  const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
-  const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
-  const __m256 s0 = _mm256_shuffle_ps(t0, t2, 0x44), s1 = _mm256_shuffle_ps(t0, t2, 0xEE);
-  const __m256 s2 = _mm256_shuffle_ps(t1, t3, 0x44), s3 = _mm256_shuffle_ps(t1, t3, 0xEE);
-  const __m256 s4 = _mm256_shuffle_ps(t4, t6, 0x44), s5 = _mm256_shuffle_ps(t4, t6, 0xEE);
-  const __m256 s6 = _mm256_shuffle_ps(t5, t7, 0x44), s7 = _mm256_shuffle_ps(t5, t7, 0xEE);
-  r[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
-  r[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
-  r[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
-  r[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
-  r[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
-  r[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
-  r[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
-  r[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+/// Field f (f < fields) of eight 32-byte records as column[f], lane j from
+/// record j. Each register is loaded as the same half of records j and
+/// j + 4 (the load unit does the cross-lane move), then transposed 4 × 4
+/// within each 128-bit half.
+template <int kFields>
+EVIO_AVX2_INLINE void columns8(const float* const (&record)[8], __m256 (&column)[kFields]) {
+  static_assert(kFields == 4 || kFields == 8);
+  for (int half = 0; half < kFields / 4; ++half) {
+    __m256 r[4];
+    for (int j = 0; j < 4; ++j)
+      r[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(record[j] + 4 * half)),
+                                  _mm_load_ps(record[j + 4] + 4 * half), 1);
+    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpacklo_ps(r[2], r[3]);
+    const __m256 t2 = _mm256_unpackhi_ps(r[0], r[1]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    column[4 * half + 0] = _mm256_shuffle_ps(t0, t1, 0x44);
+    column[4 * half + 1] = _mm256_shuffle_ps(t0, t1, 0xEE);
+    column[4 * half + 2] = _mm256_shuffle_ps(t2, t3, 0x44);
+    column[4 * half + 3] = _mm256_shuffle_ps(t2, t3, 0xEE);
+  }
 }
 
 EVIO_AVX2 int Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz,
@@ -75,30 +75,32 @@ EVIO_AVX2 int Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, co
   // Each lane's triangle record and its three vertex records, one register
   // each, then transposed into columns; a lane whose ray missed reads zeros.
   alignas(32) static const float kZeros[8] = {};
-  __m256 tri[8], vert[3][8];
+  const float* tri_record[8];
+  const float* vertex_record[3][8];
   float bu[8], bv[8];
   int hit = 0;
   for (int j = 0; j < 8; ++j) {
     const RTCRayHit& q = rays[at + static_cast<std::size_t>(j)];
     if (q.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-      tri[j] = vert[0][j] = vert[1][j] = vert[2][j] = _mm256_load_ps(kZeros);
+      tri_record[j] = vertex_record[0][j] = vertex_record[1][j] = vertex_record[2][j] = kZeros;
       bu[j] = bv[j] = 0.0f;
       continue;
     }
     hit |= 1 << j;
     const ShadeMesh& sm = shade_[q.hit.geomID];
     const ShadeTriangle& t = sm.triangles[q.hit.primID];
-    static_assert(sizeof(ShadeTriangle) == 32 && sizeof(ShadeVertex) == 32, "one record per register");
-    tri[j] = _mm256_load_ps(reinterpret_cast<const float*>(&t));
-    for (int c = 0; c < 3; ++c) vert[c][j] = _mm256_load_ps(reinterpret_cast<const float*>(&sm.vertices[t.v[c]]));
+    static_assert(sizeof(ShadeTriangle) == 32 && sizeof(ShadeVertex) == 32, "32-byte records");
+    tri_record[j] = reinterpret_cast<const float*>(&t);
+    for (int c = 0; c < 3; ++c) vertex_record[c][j] = reinterpret_cast<const float*>(&sm.vertices[t.v[c]]);
     bu[j] = q.hit.u;
     bv[j] = q.hit.v;
     out->mesh[at + static_cast<std::size_t>(j)] = q.hit.geomID;
     out->prim[at + static_cast<std::size_t>(j)] = q.hit.primID;
   }
   if (hit == 0) return 0;
-  transpose8(tri);  // ng x, y, z, then the indices
-  for (auto& v : vert) transpose8(v);  // p x, y, z, n x, y, z, uv u, v
+  __m256 tri[4], vert[3][8];
+  columns8(tri_record, tri);  // ng x, y, z, the first index
+  for (int c = 0; c < 3; ++c) columns8(vertex_record[c], vert[c]);  // p x, y, z, n x, y, z, uv u, v
   // Built from the scalars (a wide reload of eight scalar stores would stall).
   const __m256 u = _mm256_setr_ps(bu[0], bu[1], bu[2], bu[3], bu[4], bu[5], bu[6], bu[7]);
   const __m256 v = _mm256_setr_ps(bv[0], bv[1], bv[2], bv[3], bv[4], bv[5], bv[6], bv[7]);

@@ -4,6 +4,7 @@
 // without FMA, so every lane equals the scalar result bit for bit. Eigen's
 // 3-vector reductions (dot, squaredNorm) add as x + (y + z); the scalar
 // code's sums of three products (w0 a + u b + v c) add left to right.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -99,8 +100,16 @@ EVIO_AVX2 int Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, co
   }
   if (hit == 0) return 0;
   __m256 tri[4], vert[3][8];
-  columns8(tri_record, tri);  // ng x, y, z, the first index
-  for (int c = 0; c < 3; ++c) columns8(vertex_record[c], vert[c]);  // p x, y, z, n x, y, z, uv u, v
+  if (hit == 0xff && std::equal(tri_record + 1, tri_record + 8, tri_record)) {
+    // One triangle for all eight rays (large flat faces seen by coherent
+    // rays): every field is a broadcast, no transposition.
+    for (int f = 0; f < 4; ++f) tri[f] = _mm256_broadcast_ss(tri_record[0] + f);
+    for (int c = 0; c < 3; ++c)
+      for (int f = 0; f < 8; ++f) vert[c][f] = _mm256_broadcast_ss(vertex_record[c][0] + f);
+  } else {
+    columns8(tri_record, tri);  // ng x, y, z, the first index
+    for (int c = 0; c < 3; ++c) columns8(vertex_record[c], vert[c]);  // p x, y, z, n x, y, z, uv u, v
+  }
   // Built from the scalars (a wide reload of eight scalar stores would stall).
   const __m256 u = _mm256_setr_ps(bu[0], bu[1], bu[2], bu[3], bu[4], bu[5], bu[6], bu[7]);
   const __m256 v = _mm256_setr_ps(bv[0], bv[1], bv[2], bv[3], bv[4], bv[5], bv[6], bv[7]);

@@ -62,6 +62,20 @@ struct LevelParams {
   __m256i cols, rows, first;
 };
 
+/// texels[i_k] and texels[i_k + 1] of eight lanes: each pair read as one
+/// 64-bit element (four per gather instead of eight single floats), then
+/// split into the two columns.
+EVIO_AVX2_INLINE void texelPairs(const float* texels, __m256i i, __m256* first, __m256* second) {
+  const auto* base = reinterpret_cast<const long long*>(texels);
+  const __m256 lo = _mm256_castsi256_ps(_mm256_i32gather_epi64(base, _mm256_castsi256_si128(i), 4));       // lanes 0-3
+  const __m256 hi = _mm256_castsi256_ps(_mm256_i32gather_epi64(base, _mm256_extracti128_si256(i, 1), 4));  // lanes 4-7
+  // lo = a0 b0 a1 b1 | a2 b2 a3 b3, hi = a4 b4 a5 b5 | a6 b6 a7 b7
+  const __m256 a = _mm256_shuffle_ps(lo, hi, 0x88);  // a0 a1 a4 a5 | a2 a3 a6 a7
+  const __m256 b = _mm256_shuffle_ps(lo, hi, 0xDD);  // b0 b1 b4 b5 | b2 b3 b6 b7
+  *first = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(a), 0xD8));
+  *second = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(b), 0xD8));
+}
+
 /// The bilinear lookups of MipMap::bilinear, eight lanes at a time; `ok`
 /// collects the lanes that stayed inside their level (the others are
 /// recomputed by the scalar lookup).
@@ -83,8 +97,9 @@ EVIO_AVX2_INLINE __m256 bilinear8(const float* texels, const LevelParams& l, __m
   // Texel (x0, y0) of the level; outside lanes read texel 0.
   const __m256i i00 = _mm256_and_si256(in, _mm256_add_epi32(l.first, _mm256_add_epi32(_mm256_mullo_epi32(y0, l.cols), x0)));
   const __m256i i10 = _mm256_and_si256(in, _mm256_add_epi32(i00, l.cols));
-  const __m256 r00 = _mm256_i32gather_ps(texels, i00, 4), r01 = _mm256_i32gather_ps(texels + 1, i00, 4);
-  const __m256 r10 = _mm256_i32gather_ps(texels, i10, 4), r11 = _mm256_i32gather_ps(texels + 1, i10, 4);
+  __m256 r00, r01, r10, r11;
+  texelPairs(texels, i00, &r00, &r01);
+  texelPairs(texels, i10, &r10, &r11);
   const __m256 a = avx2::lerp(r00, r01, fx);
   const __m256 b = avx2::lerp(r10, r11, fx);
   return avx2::lerp(a, b, fy);

@@ -47,6 +47,10 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
               unprojectOrNan(camera_, Vec2(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5));
     }
   pixel_angle_rad_ = static_cast<float>(1.0 / camera_.intrinsics()[0]);
+  // Tile buffers per thread, reused from render to render (no allocation
+  // and first-touch page faults per frame). Copies of the renderer share
+  // the pool, which is safe: a thread uses its buffers for one tile at a time.
+  scratch_ = std::make_shared<ScratchPool>();
 #if defined(EVIO_RENDER_AVX2)
   __builtin_cpu_init();
   avx2_ = options_.avx2 && __builtin_cpu_supports("avx2") != 0;
@@ -95,11 +99,10 @@ void Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderO
   const int t = options_.tile_px;
   const int tiles = ((w + t - 1) / t) * ((h + t - 1) / t);
   std::vector<RenderStats> counts(static_cast<std::size_t>(tiles));
-  tbb::enumerable_thread_specific<Scratch> scratch;
   tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
-      Scratch& s = scratch.local();
+      Scratch& s = scratch_->local.local();
       for (int k = r.begin(); k != r.end(); ++k)
         renderTile(k, T_W_C, velocity, &out, &counts[static_cast<std::size_t>(k)], &s);
     });

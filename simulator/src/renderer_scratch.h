@@ -3,6 +3,7 @@
 // reused from tile to tile (renderer.cpp, renderer_avx2.cpp).
 
 #include <embree3/rtcore.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include <cstdint>
 #include <vector>
@@ -38,6 +39,10 @@ struct Renderer::Scratch {
   std::vector<scenes::LightColumns> light_columns;
   std::vector<float> radiance;
   std::vector<std::uint8_t> hit_mask;  ///< per group of eight rays: bit j = ray 8 g + j hit a surface
+};
+
+struct Renderer::ScratchPool {
+  tbb::enumerable_thread_specific<Scratch> local;
 };
 
 }  // namespace evio::simulator

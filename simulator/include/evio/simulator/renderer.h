@@ -18,6 +18,7 @@
 /// number of threads.
 
 #include <cstdint>
+#include <memory>
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
@@ -99,6 +100,7 @@ class Renderer {
 
  private:
   struct Scratch;
+  struct ScratchPool;  ///< per-thread Scratch, kept from render to render
   void renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
                   RenderStats* counts, Scratch* scratch) const;
   /// renderTile compiled for AVX2 (called only when avx2_).
@@ -134,6 +136,7 @@ class Renderer {
   std::size_t tile_stride_ = 0;      ///< entries per column and tile: tile_px², rounded up to 8
   float pixel_angle_rad_ = 0.0f;              ///< ≈ 1 / fx, for the texture footprint
   bool avx2_ = false;                         ///< options_.avx2 and the CPU has AVX2
+  std::shared_ptr<ScratchPool> scratch_;      ///< tile buffers (their contents do not outlive a tile)
 };
 
 }  // namespace evio::simulator

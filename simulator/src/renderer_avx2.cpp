@@ -211,6 +211,14 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
   scenes::setRayHit(active, org, Eigen::Vector3f::UnitZ());
   RTCRayHit inactive;  // a pixel without a ray (and the padding): tnear > tfar
   scenes::setRayHit(inactive, org, Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
+  // The constant parts of a ray's record (scenes::setRayHit's values).
+  static_assert(sizeof(RTCRayHit) == 80 && offsetof(RTCRayHit, ray.dir_x) == 16 && offsetof(RTCRayHit, ray.tfar) == 32 &&
+                    offsetof(RTCRayHit, hit.v) == 64 && offsetof(RTCRayHit, hit.geomID) == 72,
+                "RTCRayHit layout");
+  const auto* on_record = reinterpret_cast<const float*>(&active);
+  const auto* off_record = reinterpret_cast<const float*>(&inactive);
+  const __m256 origin_on = _mm256_castps128_ps256(_mm_loadu_ps(on_record)), origin_off = _mm256_castps128_ps256(_mm_loadu_ps(off_record));
+  const __m128 far_on = _mm_loadu_ps(on_record + 8), far_off = _mm_loadu_ps(off_record + 8), no_hit = _mm_loadu_ps(on_record + 16);
   // The tile's bearings, ray after ray (NaN: no ray; the padding too).
   const float* bearing = tile_bearings_.data() + static_cast<std::size_t>(tile) * 3 * tile_stride_;
   std::uint64_t traced = 0;
@@ -230,12 +238,22 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
       _mm256_storeu_ps(d[i], _mm256_blendv_ps(v, _mm256_set1_ps(i == 2 ? 1.0f : 0.0f), none));
     }
     const int no_ray = _mm256_movemask_ps(none);
+    // Each ray as three stores: (origin, tnear, direction, time),
+    // (tfar, mask, id, flags) and (v, primID, geomID, instID) of the hit.
+    // quad[k] holds (d_x, d_y, d_z, 0) of ray k in its low half and of ray
+    // k + 4 in its high half.
+    const __m256 dxv = _mm256_loadu_ps(d[0]), dyv = _mm256_loadu_ps(d[1]), dzv = _mm256_loadu_ps(d[2]);
+    const __m256 xy_lo = _mm256_unpacklo_ps(dxv, dyv), xy_hi = _mm256_unpackhi_ps(dxv, dyv);
+    const __m256 z0_lo = _mm256_unpacklo_ps(dzv, _mm256_setzero_ps()), z0_hi = _mm256_unpackhi_ps(dzv, _mm256_setzero_ps());
+    const __m256 quad[4] = {_mm256_shuffle_ps(xy_lo, z0_lo, 0x44), _mm256_shuffle_ps(xy_lo, z0_lo, 0xEE),
+                            _mm256_shuffle_ps(xy_hi, z0_hi, 0x44), _mm256_shuffle_ps(xy_hi, z0_hi, 0xEE)};
     for (std::size_t j = 0; j < kLanes; ++j) {
-      RTCRayHit& q = s.rays[ri + j];
-      q = (no_ray >> j) & 1 ? inactive : active;
-      q.ray.dir_x = s.dx[ri + j];
-      q.ray.dir_y = s.dy[ri + j];
-      q.ray.dir_z = s.dz[ri + j];
+      const bool off = (no_ray >> j) & 1;
+      const __m128 dir = j < 4 ? _mm256_castps256_ps128(quad[j]) : _mm256_extractf128_ps(quad[j - 4], 1);
+      auto* q = reinterpret_cast<float*>(&s.rays[ri + j]);
+      _mm256_storeu_ps(q, _mm256_insertf128_ps(off ? origin_off : origin_on, dir, 1));
+      _mm_storeu_ps(q + 8, off ? far_off : far_on);
+      _mm_storeu_ps(q + 16, no_hit);
     }
     traced += kLanes - static_cast<std::uint64_t>(__builtin_popcount(static_cast<unsigned>(no_ray)));
   }

@@ -4,8 +4,8 @@
 // without FMA, so every lane equals the scalar result bit for bit. Eigen's
 // 3-vector reductions (dot, squaredNorm) add as x + (y + z); the scalar
 // code's sums of three products (w0 a + u b + v c) add left to right.
-#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <numbers>
 
@@ -73,46 +73,58 @@ EVIO_AVX2_INLINE void columns8(const float* const (&record)[8], __m256 (&column)
 
 EVIO_AVX2 int Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, const float* dy, const float* dz,
                                        std::size_t at, SurfaceHitColumns* out) const {
-  // Each lane's triangle record and its three vertex records, one register
-  // each, then transposed into columns; a lane whose ray missed reads zeros.
-  alignas(32) static const float kZeros[8] = {};
-  const float* tri_record[8];
-  const float* vertex_record[3][8];
-  float bu[8], bv[8];
-  int hit = 0;
-  for (int j = 0; j < 8; ++j) {
-    const RTCRayHit& q = rays[at + static_cast<std::size_t>(j)];
-    if (q.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-      tri_record[j] = vertex_record[0][j] = vertex_record[1][j] = vertex_record[2][j] = kZeros;
-      bu[j] = bv[j] = 0.0f;
-      continue;
-    }
-    hit |= 1 << j;
-    const ShadeMesh& sm = shade_[q.hit.geomID];
-    const ShadeTriangle& t = sm.triangles[q.hit.primID];
-    static_assert(sizeof(ShadeTriangle) == 32 && sizeof(ShadeVertex) == 32, "32-byte records");
-    tri_record[j] = reinterpret_cast<const float*>(&t);
-    for (int c = 0; c < 3; ++c) vertex_record[c][j] = reinterpret_cast<const float*>(&sm.vertices[t.v[c]]);
-    bu[j] = q.hit.u;
-    bv[j] = q.hit.v;
-    out->mesh[at + static_cast<std::size_t>(j)] = q.hit.geomID;
-    out->prim[at + static_cast<std::size_t>(j)] = q.hit.primID;
-  }
+  // The eight hit records' ids and barycentrics, gathered with the stride
+  // of RTCRayHit.
+  static_assert(sizeof(RTCRayHit) % 4 == 0 && sizeof(ShadeTriangle) == 32 && sizeof(ShadeVertex) == 32,
+                "record layouts");
+  constexpr int kStride = sizeof(RTCRayHit) / 4;
+  const __m256i index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
+  const auto* base = reinterpret_cast<const int*>(rays + at);
+  const __m256i geom = _mm256_i32gather_epi32(base + offsetof(RTCRayHit, hit.geomID) / 4, index, 4);
+  const __m256i prim = _mm256_i32gather_epi32(base + offsetof(RTCRayHit, hit.primID) / 4, index, 4);
+  const __m256 u = _mm256_i32gather_ps(reinterpret_cast<const float*>(base) + offsetof(RTCRayHit, hit.u) / 4, index, 4);
+  const __m256 v = _mm256_i32gather_ps(reinterpret_cast<const float*>(base) + offsetof(RTCRayHit, hit.v) / 4, index, 4);
+  const __m256i invalid = _mm256_set1_epi32(static_cast<int>(RTC_INVALID_GEOMETRY_ID));
+  const int hit = ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(geom, invalid))) & 0xff;
   if (hit == 0) return 0;
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out->mesh.data() + at), geom);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out->prim.data() + at), prim);
   __m256 tri[4], vert[3][8];
-  if (hit == 0xff && std::equal(tri_record + 1, tri_record + 8, tri_record)) {
+  const unsigned g0 = rays[at].hit.geomID, p0 = rays[at].hit.primID;
+  const bool one_triangle =
+      hit == 0xff && _mm256_movemask_epi8(_mm256_and_si256(_mm256_cmpeq_epi32(geom, _mm256_set1_epi32(static_cast<int>(g0))),
+                                                           _mm256_cmpeq_epi32(prim, _mm256_set1_epi32(static_cast<int>(p0))))) == -1;
+  if (one_triangle) {
     // One triangle for all eight rays (large flat faces seen by coherent
-    // rays): every field is a broadcast, no transposition.
-    for (int f = 0; f < 4; ++f) tri[f] = _mm256_broadcast_ss(tri_record[0] + f);
-    for (int c = 0; c < 3; ++c)
-      for (int f = 0; f < 8; ++f) vert[c][f] = _mm256_broadcast_ss(vertex_record[c][0] + f);
+    // rays): every field is a broadcast.
+    const ShadeMesh& sm = shade_[g0];
+    const ShadeTriangle& t = sm.triangles[p0];
+    const auto* tr = reinterpret_cast<const float*>(&t);
+    for (int f = 0; f < 4; ++f) tri[f] = _mm256_broadcast_ss(tr + f);
+    for (int c = 0; c < 3; ++c) {
+      const auto* vr = reinterpret_cast<const float*>(&sm.vertices[t.v[c]]);
+      for (int f = 0; f < 8; ++f) vert[c][f] = _mm256_broadcast_ss(vr + f);
+    }
   } else {
+    // Each lane's triangle record and its three vertex records, then
+    // transposed into columns; a lane whose ray missed reads zeros.
+    alignas(32) static const float kZeros[8] = {};
+    const float* tri_record[8];
+    const float* vertex_record[3][8];
+    for (int j = 0; j < 8; ++j) {
+      const RTCRayHit& q = rays[at + static_cast<std::size_t>(j)];
+      if (q.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        tri_record[j] = vertex_record[0][j] = vertex_record[1][j] = vertex_record[2][j] = kZeros;
+        continue;
+      }
+      const ShadeMesh& sm = shade_[q.hit.geomID];
+      const ShadeTriangle& t = sm.triangles[q.hit.primID];
+      tri_record[j] = reinterpret_cast<const float*>(&t);
+      for (int c = 0; c < 3; ++c) vertex_record[c][j] = reinterpret_cast<const float*>(&sm.vertices[t.v[c]]);
+    }
     columns8(tri_record, tri);  // ng x, y, z, the first index
     for (int c = 0; c < 3; ++c) columns8(vertex_record[c], vert[c]);  // p x, y, z, n x, y, z, uv u, v
   }
-  // Built from the scalars (a wide reload of eight scalar stores would stall).
-  const __m256 u = _mm256_setr_ps(bu[0], bu[1], bu[2], bu[3], bu[4], bu[5], bu[6], bu[7]);
-  const __m256 v = _mm256_setr_ps(bv[0], bv[1], bv[2], bv[3], bv[4], bv[5], bv[6], bv[7]);
   const __m256 w0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), u), v);
   const auto interpolate = [&](int field) EVIO_AVX2_LAMBDA {
     return blend3(w0, vert[0][field], u, vert[1][field], v, vert[2][field]);

@@ -339,10 +339,19 @@ TEST(Renderer, Avx2PathRendersTheSameBitsAsTheBaselinePath) {
     base.avx2 = false;
     RendererOptions avx = base;
     avx.avx2 = true;
-    const Camera cam = radtan(96, 72);
+    // A distorted camera, and a fisheye whose corners have no ray (NaN bearings).
+    EquidistantCamera::Params fisheye;
+    fisheye << 18.0, 18.0, 47.5, 35.5, -0.05, 0.0, 0.0, 0.0;
+    for (const Camera& cam : {radtan(96, 72), Camera(EquidistantCamera(96, 72, fisheye))}) {
     const Renderer r_base(scene, cam, base), r_avx(scene, cam, avx);
+    int no_ray = 0;
+    for (int y = 0; y < cam.height(); ++y)
+      for (int x = 0; x < cam.width(); ++x) no_ray += std::isnan(r_base.bearing(x, y).x()) ? 1 : 0;
+    if (cam.model() == std::string("equidistant")) {
+      EXPECT_GT(no_ray, 0);  // the case is covered
+    }
     for (const auto& v : views) {
-      SCOPED_TRACE(::testing::Message() << "supersampling " << n << ", camera at " << v[0].transpose());
+      SCOPED_TRACE(::testing::Message() << cam.model() << ", supersampling " << n << ", camera at " << v[0].transpose());
       const Pose T(scenes::lookAtRotation(v[0], v[1], Vec3::UnitZ()), v[0]);
       const RenderOutput a = r_base.render(T, &vel);
       const RenderOutput b = r_avx.render(T, &vel);
@@ -350,7 +359,8 @@ TEST(Renderer, Avx2PathRendersTheSameBitsAsTheBaselinePath) {
       EXPECT_TRUE(bitEqual(a.depth, b.depth));
       EXPECT_TRUE(bitEqual(a.normal, b.normal));
       EXPECT_TRUE(bitEqual(a.flow, b.flow));
-      EXPECT_GT(cv::countNonZero(a.radiance > 0.0f), a.radiance.total() / 2);  // the views see the scene
+      EXPECT_GT(cv::countNonZero(a.radiance > 0.0f), a.radiance.total() / 8);  // the views see the scene
+    }
     }
   }
 }

@@ -11,7 +11,10 @@
 //                  ray streams (rtcIntersect1M/rtcOccluded1M, coherent flag)
 //                  and thread count as the renderer, no shading, no output;
 //   BM_Render      the full renderer (radiance, depth, normal; no flow), into
-//                  output images reused from frame to frame.
+//                  output images reused from frame to frame (its AVX2 path
+//                  when the CPU has AVX2);
+//   BM_RenderBaseline  the same with RendererOptions::avx2 off: the baseline
+//                  x86-64 path, which renders the same bits.
 // The benchmark argument is the thread count (1 and 2). Counters:
 //   rays_per_s_per_core  camera + occlusion rays traced per second of process
 //                        CPU time (CLOCK_PROCESS_CPUTIME_ID), i.e. per busy
@@ -181,11 +184,12 @@ void bareEmbree(benchmark::State& state, std::string preset, int w, int h) {
   report(state, rays, processCpuS() - cpu0);
 }
 
-void render(benchmark::State& state, std::string preset, int w, int h) {
+void renderWith(benchmark::State& state, const std::string& preset, int w, int h, bool avx2) {
   const int threads = static_cast<int>(state.range(0));
   const Scene& s = scene(preset);
   evio::simulator::RendererOptions o;
   o.threads = threads;
+  o.avx2 = avx2;
   const evio::simulator::Renderer renderer(s, camera(w, h), o);
   const evio::Pose T = evio::simulator::previewPose(s.description());
   double rays = 0.0;
@@ -198,6 +202,11 @@ void render(benchmark::State& state, std::string preset, int w, int h) {
     rays += static_cast<double>(stats.camera_rays + stats.shadow_rays);
   }
   report(state, rays, processCpuS() - cpu0);
+}
+
+void render(benchmark::State& state, std::string preset, int w, int h) { renderWith(state, preset, w, h, true); }
+void renderBaseline(benchmark::State& state, std::string preset, int w, int h) {
+  renderWith(state, preset, w, h, false);
 }
 
 void sceneBuild(benchmark::State& state, std::string preset) {
@@ -229,6 +238,10 @@ const int kRegistered = [] {
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
         benchmark::RegisterBenchmark(("BM_Render" + suffix).c_str(), render, std::string(p), r[0], r[1])
+            ->Arg(t)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+        benchmark::RegisterBenchmark(("BM_RenderBaseline" + suffix).c_str(), renderBaseline, std::string(p), r[0], r[1])
             ->Arg(t)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();

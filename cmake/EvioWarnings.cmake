@@ -10,3 +10,7 @@ if(EVIO_WARNINGS_AS_ERRORS)
   target_compile_options(evio_warnings INTERFACE -Werror)
 endif()
 target_compile_features(evio_warnings INTERFACE cxx_std_20)
+# No contraction of a*b+c into FMA, whatever -march says: the renderer's AVX2
+# and baseline paths (and the 8-lane texture lookups) must round every
+# product and sum alike to render the same bits (renderer_test.cpp).
+target_compile_options(evio_warnings INTERFACE -ffp-contract=off)

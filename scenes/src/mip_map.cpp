@@ -116,7 +116,7 @@ EVIO_AVX2 void MipMap::sample8Avx2(const float* s_in, const float* t_in, const f
   for (int k = 0; k < 8; ++k) {
     const bool fine = !(footprint[k] > 1.0f);
     lambda[k] = fine ? 0.0f : std::log2(footprint[k]);
-    l0[k] = fine ? 0 : std::min(static_cast<int>(lambda[k]), top);
+    l0[k] = fine ? 0 : !(lambda[k] < static_cast<float>(top)) ? top : static_cast<int>(lambda[k]);
   }
   const __m256 lam = _mm256_load_ps(lambda);
   const __m256i level = _mm256_load_si256(reinterpret_cast<const __m256i*>(l0));

@@ -75,8 +75,10 @@ EVIO_AVX2 int Scene::surfaceHits8Avx2(const RTCRayHit* rays, const float* dx, co
                                        std::size_t at, SurfaceHitColumns* out) const {
   // The eight hit records' ids and barycentrics, gathered with the stride
   // of RTCRayHit.
-  static_assert(sizeof(RTCRayHit) % 4 == 0 && sizeof(ShadeTriangle) == 32 && sizeof(ShadeVertex) == 32,
-                "record layouts");
+  static_assert(sizeof(RTCRayHit) % 4 == 0 && sizeof(ShadeTriangle) == 32 && sizeof(ShadeVertex) == 32 &&
+                    offsetof(ShadeTriangle, ng) == 0 && offsetof(ShadeTriangle, v) == 12 &&
+                    offsetof(ShadeVertex, p) == 0 && offsetof(ShadeVertex, n) == 12 && offsetof(ShadeVertex, uv) == 24,
+                "the field order columns8 and the broadcasts assume");
   constexpr int kStride = sizeof(RTCRayHit) / 4;
   const __m256i index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
   const auto* base = reinterpret_cast<const int*>(rays + at);
@@ -187,7 +189,10 @@ EVIO_AVX2 int Scene::shadowRays8Avx2(int k, const SurfaceHitColumns& hits, std::
       _mm256_cmp_ps(e, zero, _CMP_GT_OQ),
       _mm256_and_ps(_mm256_cmp_ps(dot(g, wi), zero, _CMP_NLE_UQ), _mm256_cmp_ps(dot(n, wi), zero, _CMP_NLE_UQ)));
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const __m256 largest = _mm256_max_ps(_mm256_and_ps(p.x, abs_mask), _mm256_max_ps(_mm256_and_ps(p.y, abs_mask), _mm256_and_ps(p.z, abs_mask)));
+  // cwiseAbs().maxCoeff() = std::max(|x|, std::max(|y|, |z|)); std::max(a, b)
+  // is (a < b ? b : a), which is _mm256_max_ps(b, a) also when one is NaN.
+  const __m256 largest = _mm256_max_ps(_mm256_max_ps(_mm256_and_ps(p.z, abs_mask), _mm256_and_ps(p.y, abs_mask)),
+                                       _mm256_and_ps(p.x, abs_mask));
   const __m256 eps = _mm256_mul_ps(_mm256_set1_ps(5e-5f), _mm256_add_ps(one, largest));
   const V3 o{_mm256_add_ps(p.x, _mm256_mul_ps(eps, g.x)), _mm256_add_ps(p.y, _mm256_mul_ps(eps, g.y)),
              _mm256_add_ps(p.z, _mm256_mul_ps(eps, g.z))};

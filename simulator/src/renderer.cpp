@@ -186,20 +186,21 @@ template <bool kAvx2>
   const Eigen::Vector3f org = T_W_C.translation().cast<float>();
 
   Scratch& s = *scratch;
-  s.rays.resize(rays);
-  s.dirs.resize(rays);
-  s.hits.resize(rays);
-  s.albedo.resize(rays);
-  s.light.resize(rays * std::max<std::size_t>(lights, 1));  // written below for every shaded ray
-  s.shadow.resize(rays * lights);
-  s.shadow_slot.resize(rays * lights);
+  const bool packets = kAvx2 && !super;  // the 8-lane path (renderer_avx2.cpp)
+  if (!packets) {
+    s.rays.resize(rays);
+    s.dirs.resize(rays);
+    s.hits.resize(rays);
+    s.albedo.resize(rays);
+    s.light.resize(rays * std::max<std::size_t>(lights, 1));  // written below for every shaded ray
+    s.shadow.resize(rays * lights);
+    s.shadow_slot.resize(rays * lights);
+  }
 
   std::size_t ri = 0;
-  if constexpr (kAvx2) {
-    if (!super) {  // eight rays at a time (renderer_avx2.cpp)
-      counts->camera_rays = setupRaysAvx2(tile, rays, R, org, scratch);
-      ri = rays;
-    }
+  if (packets) {
+    counts->camera_rays = setupRaysAvx2(tile, rays, R, org, scratch);
+    ri = rays;
   }
   for (int y = y0; y < y1 && ri < rays; ++y)
     for (int x = x0; x < x1; ++x) {
@@ -222,12 +223,10 @@ template <bool kAvx2>
 
   // Shading inputs and occlusion rays.
   const float footprint_scale = pixel_angle_rad_ / static_cast<float>(n);
-  if constexpr (kAvx2) {
-    if (!super) {  // eight rays at a time (renderer_avx2.cpp)
-      counts->shadow_rays = shadePacketsAvx2(rays, footprint_scale, scratch);
-      writeOutputs(x0, y0, x1, y1, velocity, out, *scratch);
-      return;
-    }
+  if (packets) {
+    counts->shadow_rays = shadePacketsAvx2(rays, footprint_scale, scratch);
+    writeOutputs(x0, y0, x1, y1, velocity, out, *scratch);
+    return;
   }
   std::size_t shadows = 0;
   // The shading data of large meshes is mostly not in cache: fetch the

@@ -27,17 +27,12 @@ constexpr std::size_t kLanes = 8;
 }  // namespace
 
 #if defined(__GNUC__) && defined(__x86_64__)
-#define EVIO_RENDER_AVX2 __attribute__((target("avx2")))
-#define EVIO_RENDER_AVX2_LAMBDA __attribute__((target("avx2"), always_inline))
-#else
-#define EVIO_RENDER_AVX2
-#define EVIO_RENDER_AVX2_LAMBDA
-#endif
+#define EVIO_AVX2_FN __attribute__((target("avx2")))
+#define EVIO_AVX2_LAMBDA __attribute__((target("avx2"), always_inline))
 
-#if defined(__GNUC__) && defined(__x86_64__)
 namespace {
 /// A lane mask: lane k set where its argument is 1.
-__attribute__((target("avx2"), always_inline)) inline __m256 lanes(int a, int b, int c, int d, int e, int f, int g,
+__attribute__((target("avx2"), always_inline)) inline __m256 laneMask(int a, int b, int c, int d, int e, int f, int g,
                                                                   int h) {
   return _mm256_castsi256_ps(_mm256_setr_epi32(-a, -b, -c, -d, -e, -f, -g, -h));
 }
@@ -45,7 +40,7 @@ __attribute__((target("avx2"), always_inline)) inline __m256 lanes(int a, int b,
 /// footprint[r]: the pixel's size on the surface (m) as the scalar path
 /// computes it, tfar · scale / max(−n·d, 0.2), eight rays at a time
 /// (meaningless where the ray missed).
-EVIO_RENDER_AVX2 void footprints8(std::size_t padded, float footprint_scale, const RTCRayHit* rays,
+EVIO_AVX2_FN void footprints8(std::size_t padded, float footprint_scale, const RTCRayHit* rays,
                                   const scenes::SurfaceHitColumns& c, const float* dx, const float* dy,
                                   const float* dz, float* footprint) {
   constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
@@ -67,9 +62,8 @@ EVIO_RENDER_AVX2 void footprints8(std::size_t padded, float footprint_scale, con
   }
 }
 }  // namespace
-#endif
 
-EVIO_RENDER_AVX2
+EVIO_AVX2_FN
 std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale, Scratch* scratch) const {
   Scratch& s = *scratch;
   const std::size_t padded = (rays + kLanes - 1) / kLanes * kLanes;
@@ -148,26 +142,44 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
     }
   }
 
-  // Light samples and occlusion rays (light by light).
+  // Light samples (light by light), then the occlusion rays in the scalar
+  // path's order, ray by ray and light by light within a ray, so that Embree
+  // gets the same stream.
   s.light_columns.resize(lights);
-  s.shadow.resize(padded * lights);
-  s.shadow_slot.resize(padded * lights);
-  std::size_t shadows = 0;
-  alignas(32) float ox[8], oy[8], oz[8], t_far[8];
+  s.shadow_origin.resize(lights);
+  s.shadow_need.assign(lights * (padded / kLanes), 0);
   for (std::size_t k = 0; k < lights; ++k) {
     scenes::LightColumns& lc = s.light_columns[k];
     lc.resize(padded);
+    ShadowColumns& o = s.shadow_origin[k];
+    o.x.resize(padded);
+    o.y.resize(padded);
+    o.z.resize(padded);
+    o.t_far.resize(padded);
     for (std::size_t at = 0; at < padded; at += kLanes) {
       const int hits = s.hit_mask[at / kLanes];
-      int need = scene_.shadowRays8Avx2(static_cast<int>(k), c, at, &lc, ox, oy, oz, t_far) & hits;
-      if (hits != 0xff)
-        for (std::size_t j = 0; j < kLanes; ++j)
-          if (!((hits >> j) & 1)) lc.e[at + j] = 0.0f;
-      for (; need != 0; need &= need - 1) {
-        const int j = __builtin_ctz(static_cast<unsigned>(need));
-        const std::size_t r = at + static_cast<std::size_t>(j);
-        scenes::setRay(s.shadow[shadows], Eigen::Vector3f(ox[j], oy[j], oz[j]),
-                       Eigen::Vector3f(lc.wx[r], lc.wy[r], lc.wz[r]), 0.0f, t_far[j]);
+      if (hits == 0) continue;  // nothing reads a sample of a ray that missed
+      s.shadow_need[k * (padded / kLanes) + at / kLanes] = static_cast<std::uint8_t>(
+          scene_.shadowRays8Avx2(static_cast<int>(k), c, at, &lc, o.x.data() + at, o.y.data() + at,
+                                 o.z.data() + at, o.t_far.data() + at) &
+          hits);
+    }
+  }
+  s.shadow.resize(padded * lights);
+  s.shadow_slot.resize(padded * lights);
+  std::size_t shadows = 0;
+  for (std::size_t g = 0; g < padded / kLanes; ++g) {
+    int any = 0;
+    for (std::size_t k = 0; k < lights; ++k) any |= s.shadow_need[k * (padded / kLanes) + g];
+    for (; any != 0; any &= any - 1) {
+      const auto j = static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(any)));
+      const std::size_t r = g * kLanes + j;
+      for (std::size_t k = 0; k < lights; ++k) {
+        if (!((s.shadow_need[k * (padded / kLanes) + g] >> j) & 1)) continue;
+        const scenes::LightColumns& lc = s.light_columns[k];
+        const ShadowColumns& o = s.shadow_origin[k];
+        scenes::setRay(s.shadow[shadows], Eigen::Vector3f(o.x[r], o.y[r], o.z[r]),
+                       Eigen::Vector3f(lc.wx[r], lc.wy[r], lc.wz[r]), 0.0f, o.t_far[r]);
         s.shadow_slot[shadows++] = static_cast<std::uint32_t>(k * padded + r);
       }
     }
@@ -185,9 +197,9 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   // Radiance; rays that left the scene see the sky (or nothing).
   s.radiance.resize(padded);
   for (std::size_t at = 0; at < padded; at += kLanes)
-    if (const int lanes = s.hit_mask[at / kLanes]; lanes != 0)
+    if (const int hits = s.hit_mask[at / kLanes]; hits != 0)
       scene_.radiance8Avx2(c, s.material.data(), s.dx.data(), s.dy.data(), s.dz.data(), s.albedo.data(),
-                           s.light_columns.data(), at, lanes, s.radiance.data());
+                           s.light_columns.data(), at, hits, s.radiance.data());
   for (std::size_t r = 0; r < rays; ++r)
     if (!hit(r))
       s.radiance[r] = s.rays[r].ray.tnear <= s.rays[r].ray.tfar
@@ -197,7 +209,7 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   return shadows;
 }
 
-EVIO_RENDER_AVX2
+EVIO_AVX2_FN
 std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::Matrix3f& R,
                                       const Eigen::Vector3f& org, Scratch* scratch) const {
   Scratch& s = *scratch;
@@ -207,9 +219,9 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
   s.dy.resize(padded);
   s.dz.resize(padded);
   s.bz.resize(padded);
-  RTCRayHit active;  // every field but the direction
+  RTCRayHit active{};  // every field but the direction
   scenes::setRayHit(active, org, Eigen::Vector3f::UnitZ());
-  RTCRayHit inactive;  // a pixel without a ray (and the padding): tnear > tfar
+  RTCRayHit inactive{};  // a pixel without a ray (and the padding): tnear > tfar
   scenes::setRayHit(inactive, org, Eigen::Vector3f::UnitZ(), 1.0f, 0.0f);
   // The constant parts of a ray's record (scenes::setRayHit's values).
   static_assert(sizeof(RTCRayHit) == 80 && offsetof(RTCRayHit, ray.dir_x) == 16 && offsetof(RTCRayHit, ray.tfar) == 32 &&
@@ -260,7 +272,7 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
   return traced;
 }
 
-EVIO_RENDER_AVX2
+EVIO_AVX2_FN
 void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
                             const Scratch& s) const {
   const int w = camera_.width();
@@ -271,8 +283,8 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
   const __m256i pick[3] = {_mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2), _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5),
                            _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7)};
   // Lanes holding a y or a z component: (8 q + k) mod 3 = 1 or 2.
-  const __m256 is_y[3] = {lanes(0, 1, 0, 0, 1, 0, 0, 1), lanes(0, 0, 1, 0, 0, 1, 0, 0), lanes(1, 0, 0, 1, 0, 0, 1, 0)};
-  const __m256 is_z[3] = {lanes(0, 0, 1, 0, 0, 1, 0, 0), lanes(1, 0, 0, 1, 0, 0, 1, 0), lanes(0, 1, 0, 0, 1, 0, 0, 1)};
+  const __m256 is_y[3] = {laneMask(0, 1, 0, 0, 1, 0, 0, 1), laneMask(0, 0, 1, 0, 0, 1, 0, 0), laneMask(1, 0, 0, 1, 0, 0, 1, 0)};
+  const __m256 is_z[3] = {laneMask(0, 0, 1, 0, 0, 1, 0, 0), laneMask(1, 0, 0, 1, 0, 0, 1, 0), laneMask(0, 1, 0, 0, 1, 0, 0, 1)};
   constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
   constexpr int kTfar = offsetof(RTCRay, tfar) / sizeof(float);
   const __m256i ray_index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
@@ -288,7 +300,7 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
     // during the render.
     const bool stream = (reinterpret_cast<std::uintptr_t>(depth + x0) % 32 == 0) &&
                         (reinterpret_cast<std::uintptr_t>(normal + x0) % 32 == 0);
-    const auto store = [stream](float* to, __m256 v) EVIO_RENDER_AVX2_LAMBDA {
+    const auto store = [stream](float* to, __m256 v) EVIO_AVX2_LAMBDA {
       if (stream) _mm256_stream_ps(to, v);
       else _mm256_storeu_ps(to, v);
     };
@@ -354,5 +366,18 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
   }
   _mm_sfence();  // the streaming stores are visible before the tile is reported done
 }
+
+#else  // no AVX2 code path in this build: avx2_ is never set, these are never called
+std::uint64_t Renderer::shadePacketsAvx2(std::size_t, float, Scratch*) const {
+  throw Error("Renderer: this build has no AVX2 path");
+}
+std::uint64_t Renderer::setupRaysAvx2(int, std::size_t, const Eigen::Matrix3f&, const Eigen::Vector3f&,
+                                      Scratch*) const {
+  throw Error("Renderer: this build has no AVX2 path");
+}
+void Renderer::writeOutputs(int, int, int, int, const CameraVelocity*, RenderOutput*, const Scratch&) const {
+  throw Error("Renderer: this build has no AVX2 path");
+}
+#endif
 
 }  // namespace evio::simulator

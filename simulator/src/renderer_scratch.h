@@ -16,6 +16,11 @@
 namespace evio::simulator {
 
 /// Per-thread buffers of one tile, reused from tile to tile.
+/// One light's occlusion-ray origins and lengths per ray (the AVX2 path).
+struct ShadowColumns {
+  std::vector<float> x, y, z, t_far;
+};
+
 struct Renderer::Scratch {
   std::vector<RTCRayHit> rays;
   std::vector<Eigen::Vector3f> dirs;
@@ -37,6 +42,8 @@ struct Renderer::Scratch {
   std::vector<float> bz;  ///< z of the pixel's bearing in C (NaN: no ray), for the depth
   scenes::SurfaceHitColumns columns;
   std::vector<scenes::LightColumns> light_columns;
+  std::vector<ShadowColumns> shadow_origin;  ///< per light
+  std::vector<std::uint8_t> shadow_need;     ///< per light and group of eight: the rays that need an occlusion ray
   std::vector<float> radiance;
   std::vector<std::uint8_t> hit_mask;  ///< per group of eight rays: bit j = ray 8 g + j hit a surface
 };

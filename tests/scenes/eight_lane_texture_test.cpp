@@ -21,8 +21,12 @@ namespace evio::scenes {
 namespace {
 
 bool cpuHasAvx2() {
+#if defined(__GNUC__) && defined(__x86_64__)
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx2") != 0;
+#else
+  return false;  // the 8-lane functions exist only as AVX2 code
+#endif
 }
 
 /// Same bits (so NaN == NaN and +0 != −0).

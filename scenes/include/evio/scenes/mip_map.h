@@ -97,8 +97,8 @@ inline float MipMap::sample(float s, float t, float footprint) const {
   if (!(footprint > 1.0f)) return bilinear(0, s, t);
   const float lambda = std::log2(footprint);
   const int top = levels() - 1;
-  const int l0 = std::min(static_cast<int>(lambda), top);
-  if (l0 >= top) return bilinear(top, s, t);
+  if (!(lambda < static_cast<float>(top))) return bilinear(top, s, t);  // also an infinite footprint
+  const int l0 = static_cast<int>(lambda);
   const float f = lambda - static_cast<float>(l0);
   const float a = bilinear(l0, s, t);
   return a + f * (bilinear(l0 + 1, s, t) - a);

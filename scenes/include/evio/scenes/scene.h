@@ -111,8 +111,8 @@ struct SurfaceHitColumns {
   }
 };
 
-/// Eight rays' directions and hits as Embree returned them, and the shading
-/// inputs and outputs of the 8-lane functions of Scene (columns).
+/// One shadow light's samples as columns, ray r in entry r (the renderer's
+/// AVX2 path): LightSample's fields.
 struct LightColumns {
   std::vector<float> wx, wy, wz;  ///< unit direction to the light
   std::vector<float> e;           ///< irradiance on a surface facing it (W/m²); 0 blocked or unreachable

@@ -106,7 +106,8 @@ class Renderer {
   /// renderTile compiled for AVX2 (called only when avx2_).
   void renderTileAvx2(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
                       RenderStats* counts, Scratch* scratch) const;
-  /// The AVX2 copy's albedo pass (renderer.cpp).
+  /// The AVX2 copy's albedo pass with supersampling (renderer.cpp; without
+  /// supersampling shadePacketsAvx2 does all the shading).
   template <class Shaded, class Footprint>
   void albedoPassAvx2(std::size_t rays, const Shaded& shaded, const Footprint& footprint, Scratch* scratch) const;
   /// The AVX2 copy's shading without supersampling (renderer_avx2.cpp):

@@ -116,50 +116,36 @@ void Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderO
   }
 }
 
-/// The albedo of the tile's shaded rays with the textures' 8-lane lookups:
-/// the rays are grouped by material (a counting sort, in ray order within a
-/// material) and evaluated eight at a time; a last group of fewer than eight
-/// repeats its last ray. The values are those of Scene::albedo bit for bit.
+/// The albedo of the tile's shaded rays with the textures' 8-lane lookups,
+/// grouped by material; a last group of fewer than eight repeats its last
+/// ray. The values are those of Scene::albedo bit for bit.
 template <class Shaded, class Footprint>
 [[gnu::always_inline]] inline void Renderer::albedoPassAvx2(std::size_t rays, const Shaded& shaded,
                                                           const Footprint& footprint, Scratch* scratch) const {
   Scratch& s = *scratch;
-  const auto materials = static_cast<std::size_t>(scene_.materialCount());
   s.footprint.resize(rays);
   s.material.resize(rays);
-  s.by_material.resize(rays);
-  s.material_start.assign(materials + 1, 0);
   for (std::size_t r = 0; r < rays; ++r) {
-    s.material[r] = -1;
     if (!shaded(r)) continue;
     s.material[r] = scene_.materialOf(s.hits[r].mesh);
     s.footprint[r] = footprint(r);
-    ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
   }
-  for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
-  s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
-  for (std::size_t r = 0; r < rays; ++r)
-    if (s.material[r] >= 0)
-      s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
   alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], out[8];
-  for (std::size_t m = 0; m < materials; ++m) {
-    const std::uint32_t end = s.material_start[m + 1];
-    for (std::uint32_t i = s.material_start[m]; i < end; i += 8) {
-      const std::uint32_t n = std::min<std::uint32_t>(8, end - i);
-      for (std::uint32_t k = 0; k < 8; ++k) {
-        const std::uint32_t r = s.by_material[i + std::min(k, n - 1)];
-        const scenes::SurfaceHit& h = s.hits[r];
-        px[k] = h.p.x();
-        py[k] = h.p.y();
-        pz[k] = h.p.z();
-        u[k] = h.uv.x();
-        v[k] = h.uv.y();
-        fp[k] = s.footprint[r];
-      }
-      scene_.albedo8Avx2(static_cast<int>(m), px, py, pz, u, v, fp, out);
-      for (std::uint32_t k = 0; k < n; ++k) s.albedo[s.by_material[i + k]] = out[k];
-    }
-  }
+  forMaterialGroups(rays, static_cast<std::size_t>(scene_.materialCount()), s, shaded,
+                    [&](int m, const std::uint32_t* group, std::uint32_t n) {
+                      for (std::uint32_t k = 0; k < 8; ++k) {
+                        const std::uint32_t r = group[std::min(k, n - 1)];
+                        const scenes::SurfaceHit& h = s.hits[r];
+                        px[k] = h.p.x();
+                        py[k] = h.p.y();
+                        pz[k] = h.p.z();
+                        u[k] = h.uv.x();
+                        v[k] = h.uv.y();
+                        fp[k] = s.footprint[r];
+                      }
+                      scene_.albedo8Avx2(m, px, py, pz, u, v, fp, out);
+                      for (std::uint32_t k = 0; k < n; ++k) s.albedo[group[k]] = out[k];
+                    });
 }
 
 // The tile body is compiled twice: for the baseline x86-64 target and for

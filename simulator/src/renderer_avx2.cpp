@@ -86,8 +86,6 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   s.footprint.resize(padded);
   s.material.assign(padded, 0);
   s.albedo.assign(padded, 0.0f);
-  s.by_material.resize(padded);
-  s.material_start.assign(materials + 1, 0);
   footprints8(padded, footprint_scale, s.rays.data(), c, s.dx.data(), s.dy.data(), s.dz.data(), s.footprint.data());
   bool one_material = true;  // every hit of the tile has the same material
   int first_material = -1;
@@ -127,20 +125,10 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
         gathered(first_material, group, n);
       }
     }
-  } else {  // grouped by material (a counting sort, in ray order within a material)
-    for (std::size_t r = 0; r < rays; ++r)
-      if (hit(r)) ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
-    for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
-    s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
-    for (std::size_t r = 0; r < rays; ++r)
-      if (hit(r))
-        s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
-    for (std::size_t m = 0; m < materials; ++m) {
-      const std::uint32_t end = s.material_start[m + 1];
-      for (std::uint32_t i = s.material_start[m]; i < end; i += kLanes)
-        gathered(static_cast<int>(m), s.by_material.data() + i, std::min<std::uint32_t>(kLanes, end - i));
-    }
+  } else {
+    forMaterialGroups(rays, materials, s, hit, gathered);
   }
+
 
   // Light samples (light by light), then the occlusion rays in the scalar
   // path's order, ray by ray and light by light within a ray, so that Embree

@@ -5,6 +5,7 @@
 #include <embree3/rtcore.h>
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -51,5 +52,28 @@ struct Renderer::Scratch {
 struct Renderer::ScratchPool {
   tbb::enumerable_thread_specific<Scratch> local;
 };
+
+/// The rays r < rays with included(r), grouped by their material
+/// s.material[r] (a counting sort, in ray order within a material): calls
+/// evaluate(m, group, n) for each run of n <= 8 rays group[0 .. n) of
+/// material m (the albedo passes' 8-lane texture lookups).
+template <class TileScratch, class Included, class Evaluate>
+void forMaterialGroups(std::size_t rays, std::size_t materials, TileScratch& s, const Included& included,
+                       Evaluate&& evaluate) {
+  s.by_material.resize(rays);
+  s.material_start.assign(materials + 1, 0);
+  for (std::size_t r = 0; r < rays; ++r)
+    if (included(r)) ++s.material_start[static_cast<std::size_t>(s.material[r]) + 1];
+  for (std::size_t m = 0; m < materials; ++m) s.material_start[m + 1] += s.material_start[m];
+  s.material_fill.assign(s.material_start.begin(), s.material_start.end() - 1);
+  for (std::size_t r = 0; r < rays; ++r)
+    if (included(r))
+      s.by_material[s.material_fill[static_cast<std::size_t>(s.material[r])]++] = static_cast<std::uint32_t>(r);
+  for (std::size_t m = 0; m < materials; ++m) {
+    const std::uint32_t end = s.material_start[m + 1];
+    for (std::uint32_t i = s.material_start[m]; i < end; i += 8)
+      evaluate(static_cast<int>(m), s.by_material.data() + i, std::min<std::uint32_t>(8, end - i));
+  }
+}
 
 }  // namespace evio::simulator

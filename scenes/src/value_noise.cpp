@@ -14,6 +14,7 @@
 
 #include <Eigen/Geometry>
 
+#include "evio/core/cpu_features.h"
 #include "evio/core/random_stream.h"
 
 namespace evio::noise {
@@ -25,8 +26,7 @@ ValueLattice::ValueLattice(std::uint64_t seed) : v_(static_cast<std::size_t>(kSi
   for (auto& x : v_) x = static_cast<std::int8_t>(static_cast<int>(rng.uniformInt(255)) - 127);
   v_.resize(v_.size() + 3, 0);  // 4-byte gathers at the last entry stay inside
 #if defined(EVIO_VALUE_NOISE_AVX2)
-  __builtin_cpu_init();  // in case this runs during static initialisation
-  avx2_ = __builtin_cpu_supports("avx2") != 0;
+  avx2_ = cpuHasAvx2();
 #endif
   for (int o = 0; o < kMaxOctaves; ++o) {
     const Eigen::Vector3f axis = Eigen::Vector3f(static_cast<float>(rng.uniform(-1.0, 1.0)),

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "evio/core/cpu_features.h"
 #include "evio/core/error.h"
 #include "evio/scenes/embree_util.h"
 #include "renderer_scratch.h"
@@ -52,8 +53,7 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
   // the pool, which is safe: a thread uses its buffers for one tile at a time.
   scratch_ = std::make_shared<ScratchPool>();
 #if defined(EVIO_RENDER_AVX2)
-  __builtin_cpu_init();
-  avx2_ = options_.avx2 && __builtin_cpu_supports("avx2") != 0;
+  avx2_ = options_.avx2 && cpuHasAvx2();
 #endif
   if (!avx2_ || n > 1) return;
   // The bearings tile by tile for the AVX2 path without supersampling: per

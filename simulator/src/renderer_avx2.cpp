@@ -37,19 +37,24 @@ __attribute__((target("avx2"), always_inline)) inline __m256 laneMask(int a, int
   return _mm256_castsi256_ps(_mm256_setr_epi32(-a, -b, -c, -d, -e, -f, -g, -h));
 }
 
+/// ray.tfar of the eight Embree records rays[0 .. 8).
+EVIO_AVX2_FN inline __m256 tfar8(const RTCRayHit* rays) {
+  constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
+  constexpr int kTfar = offsetof(RTCRay, tfar) / sizeof(float);
+  static_assert(sizeof(RTCRayHit) % sizeof(float) == 0 && offsetof(RTCRayHit, ray) == 0, "RTCRayHit layout");
+  const __m256i index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
+  return _mm256_i32gather_ps(reinterpret_cast<const float*>(rays) + kTfar, index, 4);
+}
+
 /// footprint[r]: the pixel's size on the surface (m) as the scalar path
 /// computes it, tfar · scale / max(−n·d, 0.2), eight rays at a time
 /// (meaningless where the ray missed).
 EVIO_AVX2_FN void footprints8(std::size_t padded, float footprint_scale, const RTCRayHit* rays,
                                   const scenes::SurfaceHitColumns& c, const float* dx, const float* dy,
                                   const float* dz, float* footprint) {
-  constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
-  constexpr int kTfar = offsetof(RTCRay, tfar) / sizeof(float);
-  static_assert(sizeof(RTCRayHit) % sizeof(float) == 0 && offsetof(RTCRayHit, ray) == 0, "RTCRayHit layout");
-  const __m256i index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
   const __m256 scale = _mm256_set1_ps(footprint_scale), min_cos = _mm256_set1_ps(0.2f);
   for (std::size_t at = 0; at < padded; at += kLanes) {
-    const __m256 t_far = _mm256_i32gather_ps(reinterpret_cast<const float*>(rays + at) + kTfar, index, 4);
+    const __m256 t_far = tfar8(rays + at);
     // n·d = n_x d_x + (n_y d_y + n_z d_z), as Eigen's dot.
     const __m256 nd = _mm256_add_ps(
         _mm256_mul_ps(_mm256_loadu_ps(c.nx.data() + at), _mm256_loadu_ps(dx + at)),
@@ -273,9 +278,6 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
   // Lanes holding a y or a z component: (8 q + k) mod 3 = 1 or 2.
   const __m256 is_y[3] = {laneMask(0, 1, 0, 0, 1, 0, 0, 1), laneMask(0, 0, 1, 0, 0, 1, 0, 0), laneMask(1, 0, 0, 1, 0, 0, 1, 0)};
   const __m256 is_z[3] = {laneMask(0, 0, 1, 0, 0, 1, 0, 0), laneMask(1, 0, 0, 1, 0, 0, 1, 0), laneMask(0, 1, 0, 0, 1, 0, 0, 1)};
-  constexpr int kStride = sizeof(RTCRayHit) / sizeof(float);
-  constexpr int kTfar = offsetof(RTCRay, tfar) / sizeof(float);
-  const __m256i ray_index = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(kStride));
   for (int y = y0; y < y1; ++y) {
     float* radiance = out->radiance.ptr<float>(y);
     float* depth = out->depth.ptr<float>(y);
@@ -301,7 +303,7 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
       const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
       const __m256 hit = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
           _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane_bit), lane_bit));
-      const __m256 range = _mm256_i32gather_ps(reinterpret_cast<const float*>(s.rays.data() + ri) + kTfar, ray_index, 4);
+      const __m256 range = tfar8(s.rays.data() + ri);
       // radiance: 0 + L (the scalar path's sum over one ray); 0 without a ray.
       const __m256 rad = _mm256_add_ps(zero, _mm256_loadu_ps(s.radiance.data() + ri));
       _mm256_storeu_ps(radiance + x, _mm256_blendv_ps(rad, zero, none));

@@ -11,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "evio/core/cpu_features.h"
 #include "evio/core/io/image_file.h"
 #include "evio/scenes/mip_map.h"
 #include "evio/scenes/texture.h"
@@ -19,15 +20,6 @@
 
 namespace evio::scenes {
 namespace {
-
-bool cpuHasAvx2() {
-#if defined(__GNUC__) && defined(__x86_64__)
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") != 0;
-#else
-  return false;  // the 8-lane functions exist only as AVX2 code
-#endif
-}
 
 /// Same bits (so NaN == NaN and +0 != −0).
 bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <numbers>
 
+#include "evio/core/cpu_features.h"
 #include "evio/core/error.h"
 #include "evio/scenes/scene_description.h"
 
@@ -323,12 +324,7 @@ const char* const kEveryShadingFeature =
     "  - {type: box, material: grey, position_m: [-0.6, -0.8, 0.3], size_m: [0.3, 0.4, 0.6]}\n";
 
 TEST(Renderer, Avx2PathRendersTheSameBitsAsTheBaselinePath) {
-#if defined(__GNUC__) && defined(__x86_64__)
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") == 0) GTEST_SKIP() << "this CPU has no AVX2: only the baseline path runs";
-#else
-  GTEST_SKIP() << "no AVX2 path on this architecture";
-#endif
+  if (!cpuHasAvx2()) GTEST_SKIP() << "this CPU has no AVX2: only the baseline path runs";
   const Scene scene(loadSceneString(kEveryShadingFeature, "s.yaml"));
   const CameraVelocity vel{Vec3(0.3, 0, 0.1), Vec3(0, 0.2, 0.05)};
   // Near and far views (footprints below and above one texel: every mip

@@ -1,5 +1,7 @@
 #include "evio/estimator/frontend/eklt_cost.h"
 
+#include "evio/core/cpu_features.h"
+
 #include <cmath>
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -138,15 +140,6 @@ __attribute__((target("avx"))) void sampleInsideAvx(const GradientTemplate& temp
   if (dg != nullptr) *dg << fdxv[0], fdyv[0], fdxv[1], fdyv[1];
 }
 
-bool cpuHasAvx() {
-  static const bool has = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx") != 0;
-  }();
-  return has;
-}
-#else
-bool cpuHasAvx() { return false; }
 #endif
 
 /// sampleInside, through the AVX path when the CPU has it (the same bits).

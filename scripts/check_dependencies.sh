@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
-# Checks the module arrows of DESIGN.md on the sources (the CMake target links
-# enforce them at link time; this catches an include of a system header such as
-# <embree3/...> or <OpenEXR/...> that would compile anyway):
+# Checks the module arrows of docs/architecture.md#dependency-direction on the
+# sources (the CMake target links enforce them at link time; this catches an
+# include of a system header such as <embree3/...> or <OpenEXR/...> that would
+# compile anyway):
 #   estimator never includes the simulator side, Embree, OpenEXR or GDAL;
 #   core, trajectories, scenes and the simulator never include the estimator;
-#   core includes no other evio module.
+#   core includes no other evio module;
+#   inside the estimator, the backend and the frontend never include each
+#   other (nor the pipeline that wires them), and the measurement contract
+#   includes nothing of the estimator: both stand on it.
+# Usage: scripts/check_dependencies.sh [source tree]   (default: this repository)
 set -u
-cd "$(dirname "$0")/.."
+cd "${1:-$(dirname "$0")/..}" || exit 2
 status=0
 check() {  # check <what> <folders> <regex>
   local hits
@@ -25,5 +30,11 @@ check "core includes another evio module" "core" \
   '#include *[<"]evio/(trajectories|scenes|simulator)/'
 check "trajectories includes scenes or the simulator" "trajectories" \
   '#include *[<"]evio/(scenes|simulator)/'
+check "the backend includes the frontend or the pipeline" "estimator/backend" \
+  '#include *[<"]evio/estimator/(frontend|pipeline)/'
+check "the frontend includes the backend or the pipeline" "estimator/frontend" \
+  '#include *[<"]evio/estimator/(backend|pipeline)/'
+check "the measurement contract includes an estimator module" "estimator/contract" \
+  '#include *[<"]evio/estimator/(frontend|backend|pipeline)/'
 [ $status -eq 0 ] && echo "dependency arrows respected"
 exit $status

@@ -1,5 +1,5 @@
 // `evio estimate <sequence> --method eklt-vio|klt-vio|tracks [--config file]
-//  [--set key=value] [--tracks file] [--track-noise px] -o <folder>`: runs an
+//  [--init static|groundtruth] [--set key=value] [--tracks file] [--track-noise px] -o <folder>`: runs an
 // estimator pipeline (estimator/pipeline/pipeline.h) over a sequence folder
 // and writes the estimate folder (trajectory.txt, trajectory_covariance.txt,
 // imu_state.txt, timing.txt, status.yaml, config.yaml, summary.yaml).
@@ -43,6 +43,7 @@ void addEstimateCommand(CLI::App& app) {
     std::vector<std::string> overrides;
     std::string tracks;
     double track_noise_px = -1.0;
+    std::string init;
     std::string output;
     bool quiet = false;
   };
@@ -57,9 +58,13 @@ void addEstimateCommand(CLI::App& app) {
                   "output)");
   cmd->add_option("--set", args->overrides,
                   "override an option: sync.n_e=3200, backend.max_slam_features=15, "
-                  "frontend.eklt.patch_size_px=17, init.mode=static (repeatable)");
+                  "frontend.eklt.patch_size_px=17, init.mode=groundtruth (repeatable)");
   cmd->add_option("--tracks", args->tracks, "tracks file for --method tracks (default: <sequence>/truth/tracks.txt)");
   cmd->add_option("--track-noise", args->track_noise_px, "Gaussian noise added to the tracks, px (tracks.noise_px)");
+  cmd->add_option("--init", args->init,
+                  "initialisation: static (from the IMU; the default) or groundtruth (from groundtruth.txt: the "
+                  "paper's protocol, what campaigns use); init.mode")
+      ->check(CLI::IsMember({"static", "groundtruth"}));
   cmd->add_option("-o,--output", args->output, "estimate folder to write")->required();
   cmd->add_flag("-q,--quiet", args->quiet, "no progress line or summary");
   cmd->callback([args] {
@@ -81,6 +86,7 @@ void addEstimateCommand(CLI::App& app) {
       }
     }
     config::applyOverride(doc, "method=" + args->method);
+    if (!args->init.empty()) config::applyOverride(doc, "init.mode=" + args->init);
     if (!args->tracks.empty()) config::applyOverride(doc, "tracks.file=" + args->tracks);
     if (args->track_noise_px >= 0.0) config::applyOverride(doc, "tracks.noise_px=" + std::to_string(args->track_noise_px));
     estimator::PipelineOptions options = estimator::PipelineOptions::forMethod(args->method);
@@ -102,9 +108,11 @@ void addEstimateCommand(CLI::App& app) {
                 std::string(io::estimateStatusName(result.status.code)).c_str(),
                 result.status.cause.empty() ? "" : " — ", result.status.cause.c_str());
     std::printf("%llu poses; %llu events, %llu frames, %llu IMU samples, %llu measurement sets\n",
-                static_cast<unsigned long long>(result.poses), static_cast<unsigned long long>(result.events),
-                static_cast<unsigned long long>(result.frames), static_cast<unsigned long long>(result.imu_samples),
-                static_cast<unsigned long long>(result.measurement_sets));
+                static_cast<unsigned long long>(result.counts.poses),
+                static_cast<unsigned long long>(result.counts.events),
+                static_cast<unsigned long long>(result.counts.frames),
+                static_cast<unsigned long long>(result.counts.imu_samples),
+                static_cast<unsigned long long>(result.counts.measurement_sets));
     const auto& t = result.times;
     std::printf("wall %.2f s (CPU %.2f s) for %.2f s of data (overall RTF %.2f wall, %.2f CPU): read %.2f, "
                 "frontend %.2f, backend %.2f, output %.2f, setup %.2f s wall\n",

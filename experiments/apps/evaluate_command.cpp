@@ -1,5 +1,5 @@
 // `evio evaluate <estimate> <groundtruth> [-o metrics.json|metrics.csv]`:
-// scores an estimated trajectory against ground truth (EVALUATION.md) and
+// scores an estimated trajectory against ground truth (docs/evaluation.md) and
 // prints a table. With -o *.json it also writes <stem>_poses.csv (per-pose
 // errors, NEES) and <stem>_rtf.csv (real-time factor series) beside it,
 // before the JSON, so a metrics.json that exists is complete.

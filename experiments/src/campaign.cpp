@@ -245,7 +245,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
                       {"{evio}", "simulate", "{scenario_file}", "-o", "{sequence}", "-q", "--set", "seed={seed}",
                        "{simulate_set}"});
     c.estimate = step(doc, steps, "estimate",
-                      {"{evio}", "estimate", "{sequence}", "{estimator_config}", "{method_option}", "-o", "estimate",
+                      {"{evio}", "estimate", "{sequence}", "{estimator_config}", "{method_option}", "--init", "groundtruth",
+                       "-o", "estimate",
                        "-q", "--set", "seed={seed}", "{estimate_set}"});
     c.evaluate_step = step(doc, steps, "evaluate",
                            {"{evio}", "evaluate", "estimate", "{sequence}", "-o", "metrics.json", "-q",

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
 
 #include "backend_scenarios.h"
 #include "evio/estimator/backend/chi_squared.h"
@@ -50,7 +51,7 @@ Summary runSeeds(const ContinuousTrajectory& traj, const test::BackendScenario& 
     ++s.runs;
     if (!r.status.ok()) {
       ++s.not_ok;
-      std::printf("seed %d: %s at %.3f s: %s\n", seed, statusName(r.status.code), nsToSeconds(r.status.t_ns),
+      std::printf("seed %d: %s at %.3f s: %s\n", seed, std::string(io::estimateStatusName(r.status.code)).c_str(), nsToSeconds(r.status.t_ns),
                   r.status.cause.c_str());
     }
     if (!r.always_pd) ++s.not_pd;

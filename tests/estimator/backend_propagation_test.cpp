@@ -59,7 +59,7 @@ TEST_P(BackendExactPropagation, FollowsTheTrueStateFor10s) {
   double max_p = 0, max_v = 0, max_th = 0;
   while (sim.next(m) && m.sample.t_ns <= end) {
     backend.addImu(m.sample);
-    const BackendEstimate e = backend.estimate();
+    const Estimate e = backend.estimate();
     ASSERT_EQ(e.t_ns, m.sample.t_ns);
     const TrajectoryState x = traj->evaluate(e.t_ns);
     max_p = std::max(max_p, (e.T_W_B.translation() - x.T_W_B.translation()).norm());

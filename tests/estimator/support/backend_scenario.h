@@ -101,7 +101,7 @@ inline ScenarioResult runBackendScenario(const ContinuousTrajectory& traj, const
   const TimeNs skip_ns = traj.startTime() + secondsToNs(sc.skip_s);
 
   ScenarioResult out;
-  auto score = [&](const BackendEstimate& e) {
+  auto score = [&](const Estimate& e) {
     out.slam_features_max = std::max(out.slam_features_max, e.num_slam_features);
     if (e.t_ns < skip_ns) return;
     const TrajectoryState truth = traj.evaluate(e.t_ns);
@@ -154,7 +154,7 @@ inline ScenarioResult runBackendScenario(const ContinuousTrajectory& traj, const
       }
       next_update += period;
     }
-    for (const BackendEstimate& e : backend.takeEstimates()) score(e);
+    for (const Estimate& e : backend.takeEstimates()) score(e);
     if (!backend.status().ok()) break;
   }
   out.status = backend.status();

@@ -18,7 +18,7 @@
 #include "evio/core/camera/camera.h"
 #include "evio/core/pose.h"
 #include "evio/core/random_stream.h"
-#include "evio/estimator/frontend/synchronizer.h"
+#include "evio/estimator/measurements.h"
 
 namespace evio::test {
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file options.h
-/// The Options pattern (DESIGN.md, Configuration). Every component has a
+/// The Options pattern (docs/architecture.md#configuration). Every component has a
 /// `struct Options` with in-class defaults, units in field names, a `///`
 /// comment per field, a `validate()` that throws evio::Error naming the
 /// field, and a `fields(v)` that lists its fields once:

@@ -48,7 +48,7 @@
 /// themselves (a method named for its variant, e.g. `features15` with
 /// `set: {method: eklt-vio, …}`), else nothing. Defaults:
 ///   simulate: {evio} simulate {scenario_file} -o {sequence} -q --set seed={seed} {simulate_set}
-///   estimate: {evio} estimate {sequence} {estimator_config} {method_option} -o estimate -q --set seed={seed}
+///   estimate: {evio} estimate {sequence} {estimator_config} {method_option} --init groundtruth -o estimate -q --set seed={seed}
 ///             {estimate_set}
 ///   evaluate: {evio} evaluate estimate {sequence} -o metrics.json -q {evaluate_set}
 /// The estimate step must write the estimate folder (estimate_files.h) into

@@ -3,7 +3,7 @@
 /// Ground truth for any estimated feature track, from the sequence's
 /// event-camera depth maps (truth/depth.txt, channel Z: z along the optical
 /// axis of E, m; +inf where no surface) and the ground-truth poses T_W_E
-/// (groundtruth.txt, DESIGN.md).
+/// (groundtruth.txt, docs/architecture.md#the-sequence-folder).
 ///
 /// A track's first sample (t0, u0) must lie within max_depth_time_offset_s of
 /// a depth-map stamp t_f, the nearest one (otherwise the track is

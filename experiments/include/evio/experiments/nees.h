@@ -1,6 +1,6 @@
 #pragma once
 /// @file nees.h
-/// Normalised estimation error squared of the pose (EVALUATION.md, NEES),
+/// Normalised estimation error squared of the pose (docs/evaluation.md#nees),
 /// for estimates with covariance (the covariance TUM variant,
 /// core/io/tum.h readTumCovariance: 3×3 orientation and 3×3 position blocks
 /// of the estimated pose T_W_X; cross terms are not in that format and are

@@ -1,6 +1,6 @@
 #pragma once
 /// @file real_time_factor.h
-/// Real-time factor (EVALUATION.md, RTF) from the estimator's timing.txt
+/// Real-time factor (docs/evaluation.md#real-time-factor) from the estimator's timing.txt
 /// (core/io/timing_txt.h): processing time over data time, sampled on a grid
 /// of data time starting at the first timing row (the estimator writes it on
 /// initialisation). Cumulative processing time P(t) and event count N(t) are

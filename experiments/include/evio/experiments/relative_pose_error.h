@@ -1,7 +1,7 @@
 #pragma once
 /// @file relative_pose_error.h
 /// Relative pose error over sub-trajectories of a given length
-/// (EVALUATION.md, Standard metrics). With d_k the ground-truth distance
+/// (docs/evaluation.md#relative-pose-error). With d_k the ground-truth distance
 /// travelled up to associated pose k, for each start i the end j is the
 /// pose whose d_j is closest to d_i + L, accepted when |d_j − d_i − L| <=
 /// tolerance·L. For that pair

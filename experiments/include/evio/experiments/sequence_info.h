@@ -1,8 +1,9 @@
 #pragma once
 /// @file sequence_info.h
-/// What a sequence folder (DESIGN.md, Event-Camera Dataset layout) contains:
-/// durations, resolution, event/IMU/frame/ground-truth counts and rates, and
-/// which files are missing. Everything is streamed; memory is flat.
+/// What a sequence folder (docs/architecture.md#the-sequence-folder,
+/// Event-Camera Dataset layout) contains: durations, resolution,
+/// event/IMU/frame/ground-truth counts and rates, and which files are missing.
+/// Everything is streamed; memory is flat.
 
 #include <cstdint>
 #include <functional>

@@ -1,8 +1,8 @@
 #pragma once
 /// @file track_sequence.h
 /// Runs a frontend (estimator/frontend/frontend.h) over a sequence folder
-/// (DESIGN.md layout), interleaving events, frames and IMU samples by time,
-/// and collects the feature tracks.
+/// (docs/architecture.md#the-sequence-folder), interleaving events, frames
+/// and IMU samples by time, and collects the feature tracks.
 
 #include <cstdint>
 #include <functional>

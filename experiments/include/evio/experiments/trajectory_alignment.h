@@ -1,6 +1,6 @@
 #pragma once
 /// @file trajectory_alignment.h
-/// Alignment of an estimate to ground truth (EVALUATION.md, Alignment).
+/// Alignment of an estimate to ground truth (docs/evaluation.md#alignment).
 /// The alignment is a similarity S = (s, R, t) applied to the estimate:
 ///   p_aligned = s·R·p̂ + t,   R_aligned = R·R̂,
 /// found by least squares over the poses of a window, then applied to the

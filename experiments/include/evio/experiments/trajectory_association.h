@@ -1,15 +1,15 @@
 #pragma once
 /// @file trajectory_association.h
-/// Association of an estimated trajectory with ground truth (EVALUATION.md,
-/// Association): the ground truth is interpolated at each estimate's time,
-/// linearly in position and by slerp in rotation, instead of taking the
-/// nearest sample. An estimate at time t (estimate clock) is compared with
+/// Association of an estimated trajectory with ground truth
+/// (docs/evaluation.md#association): the ground truth is interpolated at each
+/// estimate's time, linearly in position and by slerp in rotation, instead of
+/// taking the nearest sample. An estimate at time t (estimate clock) is compared with
 /// the ground truth at t + time_offset_s; it is associated when the nearest
 /// ground-truth sample lies within max_time_difference_s of that time
 /// (outside the ground truth's span the end sample is used, never
 /// extrapolated). Too few associations is an error, not a silent zero.
-/// Both trajectories are poses T_W_X of the same frame X (DESIGN.md: the
-/// event camera in the world frame).
+/// Both trajectories are poses T_W_X of the same frame X (the event camera in
+/// the world frame, docs/architecture.md#the-sequence-folder).
 
 #include <string>
 #include <vector>

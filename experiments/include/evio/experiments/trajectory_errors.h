@@ -1,8 +1,9 @@
 #pragma once
 /// @file trajectory_errors.h
-/// Absolute errors of an aligned estimate (EVALUATION.md, Paper metrics and
-/// Standard metrics): per-pose errors, their statistics (ATE), the EKLT-VIO
-/// paper's distance-normalised mean errors and per-minute drift.
+/// Absolute errors of an aligned estimate (docs/evaluation.md#paper-metrics
+/// and docs/evaluation.md#absolute-trajectory-error): per-pose errors, their
+/// statistics (ATE), the EKLT-VIO paper's distance-normalised mean errors and
+/// per-minute drift.
 ///
 /// Per associated pose k, with the aligned estimate (p̂_k, R̂_k) and the
 /// interpolated ground truth (p_k, R_k), both in W:

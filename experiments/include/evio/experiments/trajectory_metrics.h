@@ -1,7 +1,7 @@
 #pragma once
 /// @file trajectory_metrics.h
 /// `evio evaluate` as a library call: scores one estimated trajectory
-/// against ground truth with every metric of EVALUATION.md — association,
+/// against ground truth with every metric of docs/evaluation.md — association,
 /// alignment, the paper's MPE/MRE/MYE, ATE, RPE, NEES (with covariances),
 /// real-time factor (with timing.txt), completion and divergence (with
 /// status.yaml) — and records the alignment each number depends on.

@@ -1,7 +1,7 @@
 #pragma once
 /// @file sequence_simulator.h
 /// `evio simulate`: a scenario (scenario.h) in, a complete sequence folder
-/// (DESIGN.md, "The sequence folder") out, with exact ground truth:
+/// (docs/architecture.md#the-sequence-folder) out, with exact ground truth:
 ///
 ///   scenario.yaml         the resolved scenario (seed, version, every field)
 ///   sensors.yaml          the rig: cam0 = event camera, then the frame camera

@@ -1,0 +1,78 @@
+#pragma once
+/// @file backend_status.h
+/// What the backend reports: its status (divergence and failure are a status,
+/// never an abort), the estimate after each update, and counters.
+
+#include <cstdint>
+#include <string>
+
+#include "evio/core/eigen_types.h"
+#include "evio/core/pose.h"
+#include "evio/core/io/status_yaml.h"
+#include "evio/core/time.h"
+#include "evio/estimator/measurements.h"
+
+namespace evio::estimator {
+
+/// The backend's status. Its code is the estimate's status code
+/// (core/io/status_yaml.h): one enum from the filter to status.yaml.
+struct BackendStatus {
+  using Code = io::EstimateStatus::Code;
+  Code code = Code::kOk;
+  TimeNs t_ns = 0;    ///< time of the divergence or failure (IMU clock)
+  std::string cause;  ///< one line, e.g. "covariance not positive definite"
+
+  bool ok() const { return code == Code::kOk; }
+};
+
+/// Counters of one run (summary.yaml `backend`, written through fields()).
+struct BackendStats {
+  std::int64_t imu_samples = 0;
+  std::int64_t imu_outliers_replaced = 0;
+  std::int64_t imu_duplicates_dropped = 0;
+  std::int64_t imu_gaps = 0;
+  std::int64_t measurement_sets = 0;  ///< processed
+  std::int64_t measurements_late_dropped = 0;
+  std::int64_t measurements_before_init = 0;
+  std::int64_t features_undistort_failed = 0;
+  std::int64_t msckf_features_used = 0;
+  std::int64_t msckf_features_rejected = 0;  ///< χ² gate
+  std::int64_t msckf_features_no_parallax = 0;
+  std::int64_t msckf_triangulation_failed = 0;
+  std::int64_t slam_initialized_triangulated = 0;
+  std::int64_t slam_initialized_prior = 0;
+  std::int64_t slam_initialized_range = 0;  ///< depth prior from the range finder
+  std::int64_t slam_updates_rejected = 0;  ///< Mahalanobis gate
+  std::int64_t slam_features_removed = 0;  ///< lost, gated out or invalid
+  std::int64_t slam_reanchored = 0;
+  std::int64_t range_updates = 0;
+  std::int64_t range_rejected = 0;
+  std::int64_t zero_velocity_updates = 0;
+
+  template <class V>
+  void fields(V& v) {
+    v("imu_samples", imu_samples, "imu samples");
+    v("imu_outliers_replaced", imu_outliers_replaced, "imu outliers replaced");
+    v("imu_duplicates_dropped", imu_duplicates_dropped, "imu duplicates dropped");
+    v("imu_gaps", imu_gaps, "imu gaps");
+    v("measurement_sets", measurement_sets, "measurement sets processed");
+    v("measurements_late_dropped", measurements_late_dropped, "measurements late dropped");
+    v("measurements_before_init", measurements_before_init, "measurements before init");
+    v("features_undistort_failed", features_undistort_failed, "features undistort failed");
+    v("msckf_features_used", msckf_features_used, "msckf features used");
+    v("msckf_features_rejected", msckf_features_rejected, "MSCKF features rejected by the chi-squared gate");
+    v("msckf_features_no_parallax", msckf_features_no_parallax, "msckf features no parallax");
+    v("msckf_triangulation_failed", msckf_triangulation_failed, "msckf triangulation failed");
+    v("slam_initialized_triangulated", slam_initialized_triangulated, "slam initialized triangulated");
+    v("slam_initialized_prior", slam_initialized_prior, "slam initialized prior");
+    v("slam_initialized_range", slam_initialized_range, "SLAM features initialised with a range-finder depth prior");
+    v("slam_updates_rejected", slam_updates_rejected, "SLAM observations rejected by the Mahalanobis gate");
+    v("slam_features_removed", slam_features_removed, "SLAM features removed: lost, gated out or invalid");
+    v("slam_reanchored", slam_reanchored, "slam reanchored");
+    v("range_updates", range_updates, "range updates");
+    v("range_rejected", range_rejected, "range rejected");
+    v("zero_velocity_updates", zero_velocity_updates, "zero velocity updates");
+  }
+};
+
+}  // namespace evio::estimator

@@ -1,0 +1,120 @@
+#pragma once
+/// @file filter_state.h
+/// The EKF state of the xVIO-style backend (eklt-vio-paper.tex, Backend;
+/// ALGORITHMS.md, xVIO backend): the IMU state, a sliding window of camera
+/// pose clones and SLAM features in anchored inverse depth, with the error-state
+/// covariance P.
+///
+/// Error-state layout (the order of P's rows and columns):
+///
+///   [ δp_W_B(3) δv_W(3) δθ_B(3) δb_g(3) δb_a(3) | clone 0 (δp_W_C, δθ_C) ... clone M-1 | f_0 (δα δβ δρ) ... f_N-1 ]
+///
+/// with clones oldest first and features in insertion order.
+///
+/// Error-state convention (used by every Jacobian of the backend):
+///   positions, velocity, biases, feature parameters:  x = x̂ + δx
+///   rotations (IMU and clones), right/local perturbation:  R = R̂ · Exp(δθ)
+/// so δθ_B is expressed in B and a clone's δθ_C in its camera frame C.
+
+#include <cstdint>
+#include <vector>
+
+#include "evio/core/eigen_types.h"
+#include "evio/core/pose.h"
+#include "evio/core/time.h"
+#include "evio/estimator/measurements.h"
+
+namespace evio::estimator {
+
+// ImuState (the mean of the IMU state): measurements.h, where estimates carry it.
+
+/// A camera pose T_W_C cloned into the sliding window at a measurement time.
+struct CameraClone {
+  std::int64_t id = 0;  ///< unique within a backend run, increasing
+  TimeNs t_ns = 0;
+  Vec3 p_W_C = Vec3::Zero();
+  Quat q_W_C = Quat::Identity();
+  /// First estimate (the value when the clone was made, before any update):
+  /// where the clone's part of the unobservable yaw direction is evaluated
+  /// (FilterState::yawDirection).
+  Vec3 p_fej = Vec3::Zero();
+  Quat q_fej = Quat::Identity();
+
+  Mat3 R_W_C() const { return q_W_C.toRotationMatrix(); }
+};
+
+/// A SLAM feature in anchored inverse depth: the point in the anchor camera
+/// frame is p_Ca = [α, β, 1]ᵀ / ρ (α, β normalised image coordinates, ρ the
+/// inverse depth in 1/m).
+struct SlamFeature {
+  FeatureId id = 0;
+  std::int64_t anchor_clone_id = 0;
+  Vec3 abr = Vec3::Zero();  ///< (α, β, ρ)
+  int gate_failures = 0;    ///< consecutive Mahalanobis gate failures
+};
+
+/// Sizes of the error-state blocks.
+inline constexpr int kImuDim = 15;
+inline constexpr int kCloneDim = 6;
+inline constexpr int kFeatureDim = 3;
+/// Offsets inside the IMU block.
+inline constexpr int kIdxP = 0, kIdxV = 3, kIdxTheta = 6, kIdxBg = 9, kIdxBa = 12;
+/// Offsets inside a clone block.
+inline constexpr int kCloneP = 0, kCloneTheta = 3;
+
+class FilterState {
+ public:
+  ImuState imu;
+  std::vector<CameraClone> clones;   ///< oldest first
+  std::vector<SlamFeature> features;
+  MatX P;                            ///< error-state covariance (dim × dim), symmetric PD
+
+  /// Total error-state dimension 15 + 6 M + 3 N.
+  int dim() const { return kImuDim + kCloneDim * static_cast<int>(clones.size()) +
+                           kFeatureDim * static_cast<int>(features.size()); }
+  /// First covariance index of clone i (position in `clones`).
+  int cloneIndex(std::size_t i) const { return kImuDim + kCloneDim * static_cast<int>(i); }
+  /// First covariance index of feature j (position in `features`).
+  int featureIndex(std::size_t j) const {
+    return kImuDim + kCloneDim * static_cast<int>(clones.size()) + kFeatureDim * static_cast<int>(j);
+  }
+  /// Position of the clone with `id` in `clones`, or -1.
+  int findClone(std::int64_t id) const;
+  /// Position of the feature with `id` in `features`, or -1.
+  int findFeature(FeatureId id) const;
+
+  /// Applies an error-state correction δx (size dim()) to the mean by the
+  /// convention above (rotations: R ← R Exp(δθ)).
+  void correct(const VecX& dx);
+
+  /// Appends a clone whose error is δc = J δx (J: 6 × dim()), i.e. P grows by
+  ///   [P, P Jᵀ; J P, J P Jᵀ]  (the clone is inserted after the existing clones).
+  void addClone(const CameraClone& clone, const Eigen::Matrix<double, kCloneDim, Eigen::Dynamic>& J);
+  /// Removes clone i and its rows/columns (marginalisation).
+  void removeClone(std::size_t i);
+  /// Appends a feature with covariance P_ff (3×3) and cross-covariance P_fx (3 × dim()).
+  void addFeature(const SlamFeature& f, const Mat3& P_ff, const Eigen::Matrix<double, 3, Eigen::Dynamic>& P_fx);
+  /// Removes feature j and its rows/columns (marginalisation).
+  void removeFeature(std::size_t j);
+
+  /// P ← (P + Pᵀ)/2.
+  void symmetrize();
+
+  /// The unobservable global-yaw direction n of the error state (a rotation by
+  /// ε about e_z of W moves every pose): IMU part at `imu` (δp = e_z × p,
+  /// δv = e_z × v, δθ = R_W_Bᵀ e_z), clone parts at their first estimates
+  /// (δp_C = e_z × p_C, δθ_C = R_W_Cᵀ e_z), zero for the anchored features and
+  /// the biases. Global translation needs no such care: every model of the
+  /// backend is exactly invariant to it at any linearisation point.
+  VecX yawDirection(const ImuState& imu) const;
+
+  /// The error-state difference x ⊟ ref (the inverse of correct(): ref with
+  /// correct(x ⊟ ref) gives x). Both states must have the same clones and
+  /// features; rotations: Log(R_refᵀ R).
+  VecX minus(const FilterState& ref) const;
+};
+
+/// Removes `size` rows and columns starting at `index` from a square matrix.
+void removeRowsCols(MatX& P, int index, int size);
+
+}  // namespace evio::estimator

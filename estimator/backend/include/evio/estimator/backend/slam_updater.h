@@ -1,0 +1,69 @@
+#pragma once
+/// @file slam_updater.h
+/// SLAM features in anchored inverse depth (updater.h; the models:
+/// slam_features.h): the Mahalanobis gate on their observations, the rows
+/// they give the stacked (iterated) update, their marginalisation when lost
+/// or gated out too often, and the initialisation of new ones from a
+/// triangulated track, a range-finder depth prior or the fixed depth prior.
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "evio/estimator/backend/aux_updaters.h"
+#include "evio/estimator/backend/chi_squared.h"
+#include "evio/estimator/backend/feature_selection.h"
+#include "evio/estimator/backend/updater.h"
+
+namespace evio::estimator {
+
+/// The SLAM observations of one measurement set after the gate.
+struct SlamGate {
+  std::vector<FeatureObservation> accepted;  ///< go into the stacked update
+  std::vector<std::size_t> gated_out;        ///< positions in state.features of features to drop
+};
+
+class SlamUpdater : public Updater {
+ public:
+  /// sigma_z: σ of one normalised image coordinate; slam_chi2 gates the
+  /// observations, msckf_chi2 the triangulated initialisation; `range`
+  /// (may be null) gives the latest range reading for depth priors.
+  SlamUpdater(const UpdaterContext& context, const Camera& camera, double sigma_z, const Chi2Table* slam_chi2,
+              const Chi2Table* msckf_chi2, const RangeUpdater* range)
+      : Updater(context), camera_(camera), sigma_z_(sigma_z), slam_chi2_(slam_chi2), msckf_chi2_(msckf_chi2),
+        range_(range) {}
+  const char* name() const override { return "slam"; }
+
+  /// Marginalises the SLAM features that the observations do not contain (lost tracks).
+  void marginalizeUnobserved(const std::vector<FeatureObservation>& observations);
+  /// The observations of SLAM features in clone c (position), each gated with
+  /// 2 dof; a feature failing slam_max_gate_failures times in a row is gated out.
+  SlamGate gate(const std::vector<FeatureObservation>& observations, std::size_t c);
+  /// Rows of `accepted` at the linearisation point x (the iterated update
+  /// calls it once per iteration), constrained; a feature missing from x or
+  /// behind the clone gives zero rows.
+  void relinearize(const FilterState& x, const std::vector<FeatureObservation>& accepted, std::size_t c, MatX* H,
+                   VecX* r) const;
+  /// Drops the gated-out features and any with non-finite parameters.
+  void prune(std::vector<std::size_t> gated_out);
+  /// New SLAM features from `candidates` (taken out of `tracks`) while slots
+  /// are free. False when a triangulated initialisation's update failed.
+  bool initialize(const std::vector<FeatureId>& candidates, TrackMap* tracks);
+
+ private:
+  bool initializeTriangulated(const FeatureTrack& track, bool* done);
+  void initializeWithPrior(const FeatureTrack& track, std::size_t c);
+  /// ρ0 of a feature seen at normalised z from `clone`, from the latest range
+  /// reading (BackendOptions::range_prior_relative_sigma); nullopt when there
+  /// is none or the ray does not meet the level plane in front of the camera.
+  std::optional<double> rangeDepthPrior(const CameraClone& clone, const Vec2& z) const;
+  void removeFeature(std::size_t j);
+
+  Camera camera_;
+  double sigma_z_;
+  const Chi2Table* slam_chi2_;
+  const Chi2Table* msckf_chi2_;
+  const RangeUpdater* range_;
+};
+
+}  // namespace evio::estimator

@@ -1,0 +1,71 @@
+#pragma once
+/// @file updater.h
+/// The interface every measurement updater of the backend stands on
+/// (docs/algorithms.md#ekf-backend): one kind of measurement per subclass —
+/// MsckfUpdater (msckf_updater.h), SlamUpdater (slam_updater.h),
+/// RangeUpdater and ZeroVelocityUpdater (aux_updaters.h) — each turning its
+/// measurements into residual rows r ≈ H δx + n, n ~ N(0, σ² I), through the
+/// services below, so that the observability constraint, the χ² gate and the
+/// EKF update are written once.
+
+#include "evio/core/camera/camera.h"
+#include "evio/core/eigen_types.h"
+#include "evio/estimator/backend/backend_options.h"
+#include "evio/estimator/backend/backend_status.h"
+#include "evio/estimator/backend/filter_state.h"
+#include "evio/estimator/backend/triangulation.h"
+
+namespace evio::estimator {
+
+/// The backend's parts an updater works on (all owned by the backend).
+struct UpdaterContext {
+  FilterState* state = nullptr;
+  /// The IMU state before the updates at the filter time: where the
+  /// unobservable yaw direction is evaluated (first-estimate Jacobians).
+  const ImuState* fej_imu = nullptr;
+  const BackendOptions* options = nullptr;
+  BackendStats* stats = nullptr;
+};
+
+/// Residual rows of a stacked update.
+struct UpdateRows {
+  MatX H;  ///< rows × state dimension
+  VecX r;  ///< rows
+};
+
+class Updater {
+ public:
+  explicit Updater(const UpdaterContext& context) : ctx_(context) {}
+  virtual ~Updater() = default;
+  Updater(const Updater&) = delete;
+  Updater& operator=(const Updater&) = delete;
+
+  /// Short name of the measurement kind ("msckf", "slam", "range", "zero_velocity").
+  virtual const char* name() const = 0;
+
+  /// The observability constraint (when enabled): H ← H (I − n nᵀ/‖n‖²), the
+  /// smallest change of H with H n = 0, n the yaw direction
+  /// (FilterState::yawDirection at the first estimate).
+  void constrain(MatX* H) const;
+
+ protected:
+  /// The Mahalanobis test rᵀ (H P Hᵀ + σ² I)⁻¹ r ≤ threshold (a χ² quantile).
+  bool passesGate(const MatX& H, const VecX& r, double sigma2, double threshold) const;
+  /// Constrains H, then the EKF update (ekf_update.h); false when the
+  /// innovation covariance is not positive definite (state unchanged).
+  bool constrainAndUpdate(MatX H, const VecX& r, double sigma2) const;
+
+  /// The triangulation settings of the options (MSCKF features and SLAM initialisation).
+  TriangulationOptions triangulationOptions() const;
+  /// min_parallax_px in normalised units: divided by the mean focal length of `camera`.
+  double minParallaxNormalized(const Camera& camera) const;
+
+  FilterState& state() const { return *ctx_.state; }
+  const BackendOptions& options() const { return *ctx_.options; }
+  BackendStats& stats() const { return *ctx_.stats; }
+
+ private:
+  UpdaterContext ctx_;
+};
+
+}  // namespace evio::estimator

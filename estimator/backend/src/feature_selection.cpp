@@ -1,0 +1,73 @@
+#include "evio/estimator/backend/feature_selection.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace evio::estimator {
+
+namespace {
+bool isLive(const FeatureTrack& track, std::int64_t clone_id) {
+  return !track.observations.empty() && track.observations.back().clone_id == clone_id;
+}
+}  // namespace
+
+std::vector<FeatureObservation> undistortObservations(const MeasurementSet& set, const Camera& camera,
+                                                      BackendStats* stats) {
+  std::vector<FeatureObservation> out;
+  out.reserve(set.features.size());
+  std::unordered_set<FeatureId> seen;
+  for (const FeatureMeasurement& m : set.features) {
+    if (!seen.insert(m.id).second) continue;
+    Vec3 bearing;
+    if (!camera.unproject(m.uv, &bearing) || !(bearing.z() > 1e-6)) {
+      ++stats->features_undistort_failed;
+      continue;
+    }
+    out.push_back({m.id, bearing.head<2>() / bearing.z()});
+  }
+  return out;
+}
+
+void extendTracks(const std::vector<FeatureObservation>& observations, const FilterState& state,
+                  std::int64_t clone_id, TrackMap* tracks) {
+  for (const FeatureObservation& o : observations) {
+    if (state.findFeature(o.id) >= 0) continue;
+    FeatureTrack& track = (*tracks)[o.id];
+    track.id = o.id;
+    track.observations.push_back({clone_id, o.z});
+  }
+}
+
+std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, std::int64_t clone_id, int free_slots,
+                                            int min_length) {
+  std::vector<FeatureId> out;
+  if (free_slots <= 0) return out;
+  std::vector<std::pair<std::size_t, FeatureId>> eligible;  // (length, id)
+  for (const auto& [id, track] : tracks)
+    if (isLive(track, clone_id) && static_cast<int>(track.observations.size()) >= min_length)
+      eligible.emplace_back(track.observations.size(), id);
+  std::sort(eligible.begin(), eligible.end(),
+            [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+  for (int k = 0; k < free_slots && k < static_cast<int>(eligible.size()); ++k)
+    out.push_back(eligible[static_cast<std::size_t>(k)].second);
+  return out;
+}
+
+MsckfChoice chooseMsckfTracks(const TrackMap& tracks, std::int64_t newest_clone_id, std::int64_t oldest_clone_id,
+                              bool sliding, const std::unordered_set<FeatureId>& slam_candidates, int min_length,
+                              bool use_lost_tracks) {
+  MsckfChoice out;
+  for (const auto& [id, track] : tracks) {
+    const int length = static_cast<int>(track.observations.size());
+    if (!isLive(track, newest_clone_id)) {
+      if (use_lost_tracks && length >= min_length) out.update.push_back(id);
+      out.erase.push_back(id);
+    } else if (sliding && slam_candidates.count(id) == 0 && track.observations.front().clone_id == oldest_clone_id &&
+               length >= min_length) {
+      out.update.push_back(id);
+    }
+  }
+  return out;
+}
+
+}  // namespace evio::estimator

@@ -1,0 +1,48 @@
+#include "evio/estimator/backend/msckf_updater.h"
+
+#include <utility>
+
+#include "evio/estimator/backend/msckf_update.h"
+
+namespace evio::estimator {
+
+UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* tracks) {
+  const TriangulationOptions tri = triangulationOptions();
+  const double min_parallax = minParallaxNormalized(camera_);
+  std::vector<MsckfResidual> used;
+  for (const FeatureId id : ids) {
+    FeatureTrack& track = (*tracks)[id];
+    MsckfResidual res;
+    const MsckfOutcome outcome = msckfResidual(state(), track, min_parallax, tri, &res);
+    track.observations.clear();
+    if (outcome == MsckfOutcome::kNoParallax) {
+      ++stats().msckf_features_no_parallax;
+      continue;
+    }
+    if (outcome != MsckfOutcome::kOk) {
+      ++stats().msckf_triangulation_failed;
+      continue;
+    }
+    constrain(&res.H);
+    if (!passesGate(res.H, res.r, sigma2_, (*chi2_)(static_cast<int>(res.r.size())))) {
+      ++stats().msckf_features_rejected;
+      continue;
+    }
+    used.push_back(std::move(res));
+  }
+  last_count_ = static_cast<int>(used.size());
+  stats().msckf_features_used += last_count_;
+
+  Eigen::Index rows = 0;
+  for (const MsckfResidual& u : used) rows += u.r.size();
+  UpdateRows out{MatX(rows, state().dim()), VecX(rows)};
+  Eigen::Index row = 0;
+  for (const MsckfResidual& u : used) {
+    out.H.middleRows(row, u.H.rows()) = u.H;
+    out.r.segment(row, u.r.size()) = u.r;
+    row += u.r.size();
+  }
+  return out;
+}
+
+}  // namespace evio::estimator

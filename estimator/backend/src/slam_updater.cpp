@@ -1,0 +1,129 @@
+#include "evio/estimator/backend/slam_updater.h"
+
+#include <algorithm>
+#include <unordered_set>
+
+#include "evio/estimator/backend/msckf_update.h"
+#include "evio/estimator/backend/range_update.h"
+#include "evio/estimator/backend/slam_features.h"
+
+namespace evio::estimator {
+
+void SlamUpdater::removeFeature(std::size_t j) {
+  state().removeFeature(j);
+  ++stats().slam_features_removed;
+}
+
+void SlamUpdater::marginalizeUnobserved(const std::vector<FeatureObservation>& observations) {
+  std::unordered_set<FeatureId> observed;
+  for (const FeatureObservation& o : observations) observed.insert(o.id);
+  for (std::size_t j = state().features.size(); j-- > 0;)
+    if (observed.count(state().features[j].id) == 0) removeFeature(j);
+}
+
+SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, std::size_t c) {
+  SlamGate out;
+  const double sigma2 = sigma_z_ * sigma_z_;
+  for (const FeatureObservation& o : observations) {
+    const int j = state().findFeature(o.id);
+    if (j < 0) continue;
+    const auto jj = static_cast<std::size_t>(j);
+    Eigen::Matrix<double, 2, Eigen::Dynamic> H;
+    Vec2 r;
+    MatX Hc;
+    const bool ok = slamResidual(state(), jj, c, o.z, &H, &r);
+    if (ok) {
+      Hc = H;
+      constrain(&Hc);
+    }
+    SlamFeature& f = state().features[jj];
+    if (!ok || !passesGate(Hc, r, sigma2, (*slam_chi2_)(2))) {
+      ++stats().slam_updates_rejected;
+      if (++f.gate_failures >= options().slam_max_gate_failures) out.gated_out.push_back(jj);
+      continue;
+    }
+    f.gate_failures = 0;
+    out.accepted.push_back(o);
+  }
+  return out;
+}
+
+void SlamUpdater::relinearize(const FilterState& x, const std::vector<FeatureObservation>& accepted, std::size_t c,
+                              MatX* H, VecX* r) const {
+  const auto rows = 2 * static_cast<Eigen::Index>(accepted.size());
+  H->setZero(rows, x.dim());
+  r->setZero(rows);
+  for (std::size_t q = 0; q < accepted.size(); ++q) {
+    Eigen::Matrix<double, 2, Eigen::Dynamic> Hq;
+    Vec2 rq;
+    const int j = x.findFeature(accepted[q].id);
+    if (j < 0 || !slamResidual(x, static_cast<std::size_t>(j), c, accepted[q].z, &Hq, &rq)) continue;
+    H->middleRows<2>(2 * static_cast<Eigen::Index>(q)) = Hq;
+    r->segment<2>(2 * static_cast<Eigen::Index>(q)) = rq;
+  }
+  constrain(H);
+}
+
+void SlamUpdater::prune(std::vector<std::size_t> gated_out) {
+  std::sort(gated_out.begin(), gated_out.end());
+  for (std::size_t q = gated_out.size(); q-- > 0;) removeFeature(gated_out[q]);
+  for (std::size_t j = state().features.size(); j-- > 0;)
+    if (!state().features[j].abr.allFinite()) removeFeature(j);
+}
+
+bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap* tracks) {
+  const std::size_t c = state().clones.size() - 1;
+  for (const FeatureId id : candidates) {
+    if (static_cast<int>(state().features.size()) >= options().max_slam_features) break;
+    auto it = tracks->find(id);
+    if (it == tracks->end() || it->second.observations.empty()) continue;
+    const FeatureTrack track = it->second;
+    tracks->erase(it);
+    bool done = false;
+    if (options().slam_triangulated_init && !initializeTriangulated(track, &done)) return false;
+    if (!done) initializeWithPrior(track, c);
+  }
+  return true;
+}
+
+bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, bool* done) {
+  std::vector<CameraClone> clones;
+  std::vector<std::size_t> positions;
+  std::vector<Vec2> z;
+  gatherTrack(state(), track, &clones, &positions, &z);
+  TriangulationResult res;
+  if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) < minParallaxNormalized(camera_) ||
+      !triangulateFeature(clones, z, clones.size() - 1, triangulationOptions(), &res))
+    return true;
+  const SlamInitOutcome outcome =
+      addSlamFeatureTriangulated(state(), track, res.abr, sigma_z_ * sigma_z_, options().joseph_form, *msckf_chi2_,
+                                 [this](MatX* H) { constrain(H); });
+  if (outcome == SlamInitOutcome::kUpdateFailed) return false;
+  *done = outcome == SlamInitOutcome::kOk;
+  if (*done) ++stats().slam_initialized_triangulated;
+  return true;
+}
+
+void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c) {
+  const Vec2& z = track.observations.back().z;
+  if (const auto rho = rangeDepthPrior(state().clones[c], z)) {
+    addSlamFeatureWithPrior(state(), track.id, c, z, *rho, options().range_prior_relative_sigma * *rho, sigma_z_);
+    ++stats().slam_initialized_range;
+    return;
+  }
+  // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min).
+  const double rho0 = 1.0 / (2.0 * options().slam_min_depth_m);
+  const double sigma_rho0 = 1.0 / (4.0 * options().slam_min_depth_m);
+  addSlamFeatureWithPrior(state(), track.id, c, z, rho0, sigma_rho0, sigma_z_);
+  ++stats().slam_initialized_prior;
+}
+
+std::optional<double> SlamUpdater::rangeDepthPrior(const CameraClone& clone, const Vec2& z) const {
+  if (!options().use_range || !(options().range_prior_relative_sigma > 0.0) || !range_ || !range_->latestHit())
+    return std::nullopt;
+  const auto& hit = *range_->latestHit();
+  if (nsToSeconds(clone.t_ns - hit.first) > options().range_prior_max_age_s) return std::nullopt;
+  return inverseDepthOnLevelPlane(clone, z, hit.second.z(), options().triangulation_min_depth_m);
+}
+
+}  // namespace evio::estimator

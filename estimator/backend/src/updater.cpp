@@ -1,0 +1,35 @@
+#include "evio/estimator/backend/updater.h"
+
+#include "evio/estimator/backend/ekf_update.h"
+
+namespace evio::estimator {
+
+void Updater::constrain(MatX* H) const {
+  if (!options().observability_constraint || H->rows() == 0) return;
+  const VecX n = state().yawDirection(*ctx_.fej_imu);
+  *H -= (*H * n) * (n.transpose() / n.squaredNorm());
+}
+
+bool Updater::passesGate(const MatX& H, const VecX& r, double sigma2, double threshold) const {
+  return !(mahalanobisSquared(H, r, state().P, sigma2) > threshold);  // NaN passes, as it always did
+}
+
+bool Updater::constrainAndUpdate(MatX H, const VecX& r, double sigma2) const {
+  constrain(&H);
+  return ekfUpdate(state(), H, r, sigma2, options().joseph_form);
+}
+
+TriangulationOptions Updater::triangulationOptions() const {
+  TriangulationOptions t;
+  t.max_iterations = options().triangulation_max_iterations;
+  t.tolerance = options().triangulation_tolerance;
+  t.min_depth_m = options().triangulation_min_depth_m;
+  return t;
+}
+
+double Updater::minParallaxNormalized(const Camera& camera) const {
+  const Vec4 k = camera.intrinsics();
+  return options().min_parallax_px / (0.5 * (k(0) + k(1)));
+}
+
+}  // namespace evio::estimator

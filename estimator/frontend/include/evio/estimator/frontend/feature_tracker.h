@@ -1,0 +1,48 @@
+#pragma once
+/// @file feature_tracker.h
+/// The interface every frontend tracker implements (EKLT, KLT), so that the
+/// synchronizer and the backend pipelines treat them alike.
+///
+/// Inputs must come in time order across all three streams: the caller
+/// interleaves events, frames and IMU samples by timestamp (events with
+/// t < t_frame before the frame at t_frame).
+
+#include <cstddef>
+#include <string_view>
+
+#include <opencv2/core/mat.hpp>
+
+#include "evio/core/event.h"
+#include "evio/core/imu_sample.h"
+#include "evio/estimator/measurements.h"
+
+namespace evio::estimator {
+
+class FeatureTracker {
+ public:
+  virtual ~FeatureTracker() = default;
+
+  /// A frame at time t_ns: CV_8UC1 intensity, or CV_32FC1 taken as a log
+  /// image already (e.g. from ImageReconstructor). Size must be the camera's.
+  virtual void addFrame(TimeNs t_ns, const cv::Mat& image) = 0;
+
+  /// Events [begin, end) of `events` (non-decreasing time). No-op for
+  /// frame-only trackers.
+  virtual void addEvents(const EventArray& events, std::size_t begin, std::size_t end) = 0;
+  void addEvents(const EventArray& events) { addEvents(events, 0, events.size()); }
+
+  /// One gyro/accelerometer sample (used for feature prediction when enabled).
+  virtual void addImu(const ImuSample& sample) = 0;
+
+  /// Moves the track points produced since the last call into `out`
+  /// (appended, in the order they were produced).
+  virtual void drainTrackPoints(TrackPoints& out) = 0;
+
+  /// Number of tracks currently alive (being tracked).
+  virtual std::size_t numAlive() const = 0;
+
+  /// "eklt" or "klt".
+  virtual std::string_view name() const = 0;
+};
+
+}  // namespace evio::estimator

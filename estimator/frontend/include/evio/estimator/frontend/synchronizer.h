@@ -1,0 +1,93 @@
+#pragma once
+/// @file synchronizer.h
+/// Asynchronous feature tracks → synchronous measurement sets for the filter
+/// (eklt-vio-paper.tex, Frontend Adaptations; ALGORITHMS.md, Synchronisation).
+///
+/// Triggers:
+///  - "events": every n_e events in total, if any track moved since the last
+///    update. The update time is the latest timestamp among the live tracks
+///    and must be strictly after the previous update (else no update).
+///  - "fixed_rate": every 1/rate_hz seconds of data time.
+///  - "track_time": whenever the latest track timestamp advances (e.g. KLT,
+///    whose points all carry frame times: one update per frame).
+/// Independently, min_rate_hz > 0 forces an update when no update happened
+/// for 1/min_rate_hz seconds of data time (scenes without events).
+/// At an update every live track is linearly extrapolated to the update time
+/// from its last two points (held when it has one; at most
+/// max_extrapolation_s beyond its last point), and carries the position it
+/// was sent with at the previous update.
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "evio/core/options.h"
+#include "evio/estimator/measurements.h"
+
+namespace evio::estimator {
+
+struct SynchronizerOptions {
+  std::string trigger = "events";     ///< events | fixed_rate | track_time
+  int n_e = 3200;                     ///< events per update ("events")
+  double rate_hz = 30.0;              ///< update rate ("fixed_rate")
+  double min_rate_hz = 0.0;           ///< minimum update rate (0: off)
+  double max_extrapolation_s = 0.1;   ///< extrapolation horizon beyond a track's last point
+
+  template <class V>
+  void fields(V& v) {
+    v("trigger", trigger, "events, fixed_rate or track_time");
+    v("n_e", n_e, "events per update");
+    v("rate_hz", rate_hz, "update rate for fixed_rate, Hz");
+    v("min_rate_hz", min_rate_hz, "minimum update rate, Hz (0: off)");
+    v("max_extrapolation_s", max_extrapolation_s, "extrapolation horizon, s");
+  }
+  void validate() const;
+};
+
+class Synchronizer {
+ public:
+  explicit Synchronizer(const SynchronizerOptions& options);
+
+  /// Track points in the order the tracker produced them.
+  void addTrackPoints(const TrackPoints& points);
+  /// `count` more events were processed; the newest has time t_last_ns.
+  void addEvents(std::uint64_t count, TimeNs t_last_ns);
+  /// Data time has reached t_ns (IMU, frames): fixed and minimum rates.
+  void advanceTime(TimeNs t_ns);
+
+  /// Pops the oldest pending measurement set; false when none.
+  bool poll(MeasurementSet* out);
+
+  std::size_t numLiveTracks() const { return tracks_.size(); }
+
+ private:
+  struct Track {
+    TimeNs t[2] = {0, 0};   // last two points, t[1] newest
+    Vec2 uv[2] = {Vec2::Zero(), Vec2::Zero()};
+    int n = 0;
+    bool moved = true;
+    bool sent = false;
+    Vec2 last_sent = Vec2::Zero();
+  };
+  enum class Trigger { kEvents, kFixedRate, kTrackTime };
+  Vec2 extrapolate(const Track& track, TimeNs t_ns) const;
+  void update(TimeNs t_ns);
+  TimeNs latestTrackTime() const;
+
+  SynchronizerOptions options_;
+  Trigger trigger_;
+  std::unordered_map<FeatureId, Track> tracks_;
+  std::vector<FeatureId> order_;  // ids in creation order, for deterministic output
+  std::deque<MeasurementSet> pending_;
+  std::uint64_t events_since_update_ = 0;
+  bool any_update_ = false;
+  TimeNs last_update_ns_ = 0;
+  TimeNs last_time_ns_ = 0;
+  bool any_time_ = false;
+  TimeNs next_fixed_ns_ = -1;
+  TimeNs latest_point_ns_ = 0;
+};
+
+}  // namespace evio::estimator

@@ -1,0 +1,129 @@
+#pragma once
+/// @file pipeline.h
+/// The estimator pipelines (eklt-vio-paper.tex; ALGORITHMS.md): EKLT-VIO
+/// (EKLT frontend + synchroniser + EKF backend), KLT-VIO (KLT frontend +
+/// backend updated per frame) and `tracks` (backend on feature tracks read
+/// from a file), run over a sequence folder (DESIGN.md layout, recorded or
+/// simulated) and written as an estimate folder (estimate_writer.h).
+///
+/// Streaming (memory flat in the sequence length): events in chunks, IMU one
+/// sample at a time and frames loaded when their turn comes, all merged in
+/// time order on the camera clock (sequence_reader.h); the frontend, the
+/// synchroniser and the backend are fed as the data arrive, exactly as they
+/// would be online.
+///
+/// Calibration: sensors.yaml, else calib.txt + options.calibration
+/// (sequence_rig.h). The trajectory is the event camera's pose
+/// T_W_E = T_W_B · T_B_E (the frame of groundtruth.txt) whatever camera the
+/// tracker used.
+///
+/// Initialisation (options.init, pipeline_options.h): from groundtruth.txt at
+/// the first IMU time (the paper's protocol), or static.
+///
+/// Bad input and degraded modes (each an evio::Error with one clear message,
+/// or a status in status.yaml — never a crash):
+///  - events out of order, malformed files: evio::Error from the readers,
+///    naming file and line (or HDF5 index);
+///  - no frames (images.txt missing or empty): eklt-vio with
+///    frontend.image_source frames and klt-vio throw an evio::Error saying so
+///    (eklt-vio runs without frames with frontend.image_source reconstructed);
+///  - calibration that does not match the data (frame size or the sensor size
+///    stored in events.h5 differing from sensors.yaml / calib.txt, events
+///    outside the sensor): evio::Error naming both sizes;
+///  - IMU gaps: gaps up to backend.imu_max_gap_s are normal, longer ones are
+///    bridged by interpolation and counted (summary.yaml imu_gaps); a gap
+///    above backend.imu_fail_gap_s after initialisation ends the run with
+///    status `failed` ("IMU gap of … s"), the trajectory up to the gap kept.
+///    The same holds when imu.txt ends while events or frames continue;
+///  - divergence: status `diverged` with its time and cause (backend_status.h);
+///  - static initialisation that never finds a still window: status `failed`.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "evio/core/io/status_yaml.h"
+#include "evio/estimator/backend/backend_status.h"
+#include "evio/estimator/pipeline/pipeline_options.h"
+
+namespace evio::estimator {
+
+struct PipelineProgress {
+  double fraction = 0.0;      ///< share of the data read, 0..1
+  TimeNs t_ns = 0;            ///< data time reached (camera clock)
+  std::uint64_t events = 0;   ///< events read so far
+  bool initialized = false;
+};
+using PipelineProgressCallback = std::function<void(const PipelineProgress&)>;
+
+/// Wall-clock seconds per stage (steady clock), summed over the run.
+struct PipelineStageTimes {
+  double setup_s = 0.0;     ///< opening files, calibration, initial ground truth
+  double read_s = 0.0;      ///< reading events, IMU and frames
+  double frontend_s = 0.0;  ///< pre-filters, reconstruction, tracking, synchroniser
+  double backend_s = 0.0;   ///< EKF propagation and updates
+  double output_s = 0.0;    ///< writing the estimate files
+  double total_s = 0.0;     ///< the whole run
+  double cpu_s = 0.0;       ///< CPU time of the process over the whole run (std::clock, all threads)
+
+  template <class V>
+  void fields(V& v) {
+    v("setup_s", setup_s, "opening files, calibration, initial ground truth, s");
+    v("read_s", read_s, "reading events, IMU and frames, s");
+    v("frontend_s", frontend_s, "pre-filters, reconstruction, tracking, synchroniser, s");
+    v("backend_s", backend_s, "EKF propagation and updates, s");
+    v("output_s", output_s, "writing the estimate files, s");
+    v("total_s", total_s, "the whole run, s");
+    v("cpu_s", cpu_s, "CPU time of the process over the whole run, s");
+  }
+};
+
+/// What went through the chain (summary.yaml `counts`).
+struct PipelineCounts {
+  std::uint64_t events = 0;            ///< events read
+  std::uint64_t events_kept = 0;       ///< after the pre-filters
+  std::uint64_t frames = 0;            ///< frames given to the frontend
+  std::uint64_t imu_samples = 0;
+  std::uint64_t track_points = 0;
+  std::uint64_t measurement_sets = 0;  ///< given to the backend
+  std::uint64_t poses = 0;             ///< lines of trajectory.txt
+
+  template <class V>
+  void fields(V& v) {
+    v("events", events, "events read");
+    v("events_kept", events_kept, "events after the pre-filters");
+    v("frames", frames, "frames given to the frontend");
+    v("imu_samples", imu_samples, "IMU samples read");
+    v("track_points", track_points, "track points from the frontend");
+    v("measurement_sets", measurement_sets, "measurement sets given to the backend");
+    v("poses", poses, "lines of trajectory.txt");
+  }
+};
+
+struct PipelineResult {
+  io::EstimateStatus status;
+  BackendStats backend;
+  PipelineStageTimes times;
+  PipelineCounts counts;
+  std::string rig_source;          ///< sensors.yaml or calib.txt
+  std::string tracker_camera;      ///< camera whose pixels the tracker used
+  std::string events_file;         ///< events.h5, events.txt or empty
+  TimeNs t_first_ns = 0;           ///< data span read (camera clock)
+  TimeNs t_last_ns = 0;
+  std::optional<TimeNs> initialization_t_ns;
+  std::vector<std::string> notes;  ///< degraded modes and choices made (one line each)
+};
+
+/// Runs `options.method` over `sequence` and writes the estimate folder
+/// `output` (created when missing). Throws evio::Error for bad input (see
+/// the file comment); filter divergence and failure are in the result and
+/// status.yaml instead.
+PipelineResult runPipeline(const std::string& sequence, const PipelineOptions& options, const std::string& output,
+                           const PipelineProgressCallback& progress = {});
+
+/// summary.yaml: the result's counters, stage times and backend statistics.
+std::string formatPipelineSummary(const PipelineResult& result, const PipelineOptions& options);
+
+}  // namespace evio::estimator

@@ -1,0 +1,112 @@
+#pragma once
+/// @file stages.h
+/// The estimator's stages, in the order data flows (pipeline.h wires them):
+///
+///   SequenceReader ─SequenceItem─► PrefilterStage ─SequenceItem─► FrontendStage
+///     ─FrontendOutput─► SynchronizerStage ─BackendInput─► BackendStage ─Estimate─► EstimateWriter
+///
+/// The `tracks` method replaces prefilter, frontend and synchroniser by
+/// TracksStage (SequenceItem → BackendInput). IMU and range readings travel
+/// down the chain with the visual data, so every stage sees one time-ordered
+/// stream. Times are on the camera clock except the IMU samples' own t_ns
+/// (IMU clock, t_imu = t_cam + offset).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <variant>
+#include <vector>
+
+#include "evio/estimator/backend/backend.h"
+#include "evio/estimator/frontend/event_prefilter.h"
+#include "evio/estimator/frontend/frontend.h"
+#include "evio/estimator/frontend/synchronizer.h"
+#include "evio/estimator/measurements.h"
+#include "evio/estimator/pipeline/groundtruth_init.h"
+#include "evio/estimator/pipeline/sequence_reader.h"
+#include "evio/estimator/pipeline/stage.h"
+#include "evio/estimator/pipeline/tracks_input.h"
+
+namespace evio::estimator {
+
+/// What the frontend passes on for one input.
+struct FrontendOutput {
+  SequenceItem::Kind kind = SequenceItem::Kind::kEvents;
+  TimeNs t_ns = 0;              ///< camera clock
+  TrackPoints points;           ///< kEvents, kFrame: the track points the input produced
+  std::uint64_t events = 0;     ///< kEvents: events that reached the tracker
+  ImuSample imu;                ///< kImu (IMU clock)
+  io::RangeSample range;        ///< kRange
+};
+
+/// What the backend consumes: IMU samples (IMU clock), measurement sets and
+/// range readings (camera clock), each stream in time order.
+using BackendInput = std::variant<ImuSample, MeasurementSet, RangeMeasurement>;
+
+/// Event pre-filters (event_prefilter.h); other items pass unchanged.
+class PrefilterStage : public Stage<SequenceItem, SequenceItem> {
+ public:
+  PrefilterStage(const EventPrefilterOptions& options, int width, int height);
+  void process(SequenceItem& in, std::vector<SequenceItem>& out) override;
+  std::uint64_t numEventsSeen() const { return seen_; }
+  std::uint64_t numEventsKept() const { return kept_; }
+
+ private:
+  std::unique_ptr<EventPrefilter> filter_;  // null: pass-through
+  EventArray filtered_;
+  std::uint64_t seen_ = 0, kept_ = 0;
+};
+
+/// The tracker (EKLT or KLT, with the optional reconstruction): events and
+/// frames in, track points out; IMU samples feed its gyro prediction.
+class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
+ public:
+  /// `options.prefilter` is ignored: the PrefilterStage runs before.
+  FrontendStage(const FrontendOptions& options, const CameraSensor& camera);
+  void process(SequenceItem& in, std::vector<FrontendOutput>& out) override;
+  std::uint64_t numFrames() const { return frames_; }
+
+ private:
+  Frontend frontend_;
+  std::uint64_t frames_ = 0;
+};
+
+/// Asynchronous track points → measurement sets (synchronizer.h); IMU and
+/// range readings pass on to the backend, each before the sets it released.
+class SynchronizerStage : public Stage<FrontendOutput, BackendInput> {
+ public:
+  explicit SynchronizerStage(const SynchronizerOptions& options) : sync_(options) {}
+  void process(FrontendOutput& in, std::vector<BackendInput>& out) override;
+  std::uint64_t numTrackPoints() const { return track_points_; }
+
+ private:
+  Synchronizer sync_;
+  std::uint64_t track_points_ = 0;
+};
+
+/// The `tracks` method: measurement sets from a tracks file (tracks_input.h).
+class TracksStage : public Stage<SequenceItem, BackendInput> {
+ public:
+  explicit TracksStage(std::unique_ptr<TracksInput> input) : input_(std::move(input)) {}
+  void process(SequenceItem& in, std::vector<BackendInput>& out) override;
+
+ private:
+  std::unique_ptr<TracksInput> input_;
+  std::vector<MeasurementSet> sets_;
+};
+
+/// The EKF (backend.h): initialised from ground truth when the caller gave
+/// an initializer, else by the backend's own static initialisation.
+class BackendStage : public Stage<BackendInput, Estimate> {
+ public:
+  BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer);
+  void process(BackendInput& in, std::vector<Estimate>& out) override;
+  std::uint64_t numMeasurementSets() const { return measurement_sets_; }
+
+ private:
+  Backend& backend_;
+  std::optional<GroundTruthInitializer> initializer_;
+  std::uint64_t measurement_sets_ = 0;
+};
+
+}  // namespace evio::estimator

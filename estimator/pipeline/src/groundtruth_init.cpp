@@ -1,0 +1,98 @@
+#include "evio/estimator/pipeline/groundtruth_init.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+#include "evio/core/error.h"
+#include "evio/core/io/tum.h"
+
+namespace evio::estimator {
+
+namespace {
+
+std::string secondsText(TimeNs t_ns) { return std::to_string(nsToSeconds(t_ns)) + " s"; }
+
+/// "1.234 s": seconds to the millisecond.
+std::string millisecondText(TimeNs t_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3f s", nsToSeconds(t_ns));
+  return buf;
+}
+
+}  // namespace
+
+Pose interpolatePose(const Trajectory& T_W_C, TimeNs t_ns) {
+  require(!T_W_C.empty(), "ground truth: no poses");
+  if (t_ns < T_W_C.front().t_ns || t_ns > T_W_C.back().t_ns)
+    throw Error("ground truth: time " + secondsText(t_ns) + " outside its span [" + secondsText(T_W_C.front().t_ns) +
+                ", " + secondsText(T_W_C.back().t_ns) + "]");
+  const auto it = std::lower_bound(T_W_C.begin(), T_W_C.end(), t_ns,
+                                   [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
+  if (it->t_ns == t_ns) return it->pose;
+  const StampedPose& b = *it;
+  const StampedPose& a = *(it - 1);
+  const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+  const Vec3 p = (1.0 - s) * a.pose.translation() + s * b.pose.translation();
+  const Quat q = a.pose.quaternion().slerp(s, b.pose.quaternion());
+  return Pose(q.normalized(), p);
+}
+
+ImuState initialStateFromTrajectory(const Trajectory& T_W_C, TimeNs t_cam_ns, const Pose& T_B_C,
+                                    double half_window_s, TimeNs time_offset_cam_imu_ns) {
+  require(half_window_s > 0.0, "initialStateFromTrajectory: half_window_s must be > 0");
+  const Pose T_C_B = T_B_C.inverse();
+  const Pose T_W_B = interpolatePose(T_W_C, t_cam_ns) * T_C_B;
+  const TimeNs h = secondsToNs(half_window_s);
+  const TimeNs ta = std::max(T_W_C.front().t_ns, t_cam_ns - h);
+  const TimeNs tb = std::min(T_W_C.back().t_ns, t_cam_ns + h);
+  if (tb <= ta)
+    throw Error("ground truth: no span around " + secondsText(t_cam_ns) + " to take the initial velocity from");
+  const Vec3 pa = (interpolatePose(T_W_C, ta) * T_C_B).translation();
+  const Vec3 pb = (interpolatePose(T_W_C, tb) * T_C_B).translation();
+  ImuState x;
+  x.t_ns = t_cam_ns + time_offset_cam_imu_ns;
+  x.p_W_B = T_W_B.translation();
+  x.q_W_B = T_W_B.quaternion();
+  x.v_W = (pb - pa) / nsToSeconds(tb - ta);
+  return x;
+}
+
+GroundTruthInitializer::GroundTruthInitializer(std::string groundtruth_path, double start_offset_s,
+                                               double velocity_half_window_s, const Pose& T_B_C,
+                                               TimeNs time_offset_cam_imu_ns)
+    : path_(std::move(groundtruth_path)),
+      start_offset_s_(start_offset_s),
+      half_window_s_(velocity_half_window_s),
+      T_B_C_(T_B_C),
+      offset_ns_(time_offset_cam_imu_ns) {}
+
+std::optional<ImuState> GroundTruthInitializer::offer(TimeNs t_imu_ns) {
+  const TimeNs t_cam_ns = t_imu_ns - offset_ns_;
+  if (!t_init_cam_ns_) {
+    const Trajectory head = readTrajectoryPrefix(path_, t_cam_ns);
+    if (head.empty()) throw Error(path_ + ": no poses");
+    t_init_cam_ns_ = std::max(t_cam_ns, head.front().t_ns) + secondsToNs(start_offset_s_);
+  }
+  if (t_cam_ns < *t_init_cam_ns_) return std::nullopt;
+  const Trajectory gt = readTrajectoryPrefix(path_, *t_init_cam_ns_ + secondsToNs(half_window_s_));
+  if (gt.back().t_ns < *t_init_cam_ns_)
+    throw Error(path_ + ": ends at " + millisecondText(gt.back().t_ns) + ", before the initialisation time " +
+                millisecondText(*t_init_cam_ns_));
+  return initialStateFromTrajectory(gt, *t_init_cam_ns_, T_B_C_, half_window_s_, offset_ns_);
+}
+
+Trajectory readTrajectoryPrefix(const std::string& path, TimeNs t_until_ns) {
+  io::TumReader reader(path);
+  Trajectory out;
+  StampedPose p;
+  while (reader.next(p)) {
+    if (!out.empty() && p.t_ns <= out.back().t_ns)
+      throw Error(path + ": time does not increase at " + secondsText(p.t_ns));
+    out.push_back(p);
+    if (p.t_ns > t_until_ns) break;
+  }
+  return out;
+}
+
+}  // namespace evio::estimator

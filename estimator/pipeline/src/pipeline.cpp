@@ -1,0 +1,349 @@
+#include "evio/estimator/pipeline/pipeline.h"
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+
+#include "evio/core/error.h"
+#include "evio/core/io/config.h"
+#include "evio/core/io/images_txt.h"
+#include "evio/estimator/pipeline/estimate_writer.h"
+#include "evio/estimator/pipeline/method.h"
+#include "evio/estimator/pipeline/sequence_rig.h"
+#include "evio/estimator/pipeline/stages.h"
+
+namespace evio::estimator {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::string secondsText(TimeNs t_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3f s", nsToSeconds(t_ns));
+  return buf;
+}
+
+/// Adds the wall time of its lifetime to a counter.
+class StageTimer {
+ public:
+  explicit StageTimer(double* acc) : acc_(acc), start_(Clock::now()) {}
+  ~StageTimer() { *acc_ += std::chrono::duration<double>(Clock::now() - start_).count(); }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  double* acc_;
+  Clock::time_point start_;
+};
+
+/// One run of the pipeline; see pipeline.h. setup() builds the stages once;
+/// loop() reads the sequence and hands every item down the chain
+/// (runStages), then checks the run's health and writes progress and timing.
+class PipelineRun {
+ public:
+  PipelineRun(const std::string& sequence, const PipelineOptions& options, const std::string& output,
+              const PipelineProgressCallback& progress)
+      : sequence_(sequence), options_(options), output_(output), progress_(progress) {}
+
+  PipelineResult run() {
+    run_start_ = Clock::now();
+    run_start_cpu_ = std::clock();
+    setup();
+    loop();
+    finish();
+    return result_;
+  }
+
+ private:
+  void setup();
+  void setupReader(const std::vector<io::ImageStamp>& images);
+  void setupStages();
+  void loop();
+  void runStages(SequenceItem& item);
+  void afterItem(TimeNs t_ns);
+  void writeTiming(TimeNs t_ns);
+  void finish();
+  io::EstimateStatus finalStatus() const;
+  /// Processing time since the loop started on the clock of output.timing_clock.
+  double elapsed() const {
+    if (cpu_clock_) return static_cast<double>(std::clock() - loop_start_cpu_) / CLOCKS_PER_SEC;
+    return std::chrono::duration<double>(Clock::now() - loop_start_).count();
+  }
+
+  const std::string& sequence_;
+  const PipelineOptions& options_;
+  const std::string& output_;
+  const PipelineProgressCallback& progress_;
+  PipelineResult result_;
+  Method method_ = Method::kEkltVio;
+
+  SequenceRig rig_;
+  const CameraSensor* tracker_camera_ = nullptr;
+  cv::Size frame_size_;
+  std::string frame_size_from_;
+  TimeNs offset_ns_ = 0;
+
+  // The chain, in the order data flows (stages.h).
+  std::unique_ptr<SequenceReader> reader_;
+  std::unique_ptr<PrefilterStage> prefilter_;
+  std::unique_ptr<FrontendStage> frontend_;
+  std::unique_ptr<SynchronizerStage> sync_;
+  std::unique_ptr<TracksStage> tracks_;  // replaces prefilter, frontend and synchroniser for `tracks`
+  std::unique_ptr<Backend> backend_;
+  std::unique_ptr<BackendStage> backend_stage_;
+  std::unique_ptr<EstimateWriter> writer_;
+  // Each stage's outputs, reused from item to item.
+  std::vector<SequenceItem> filtered_;
+  std::vector<FrontendOutput> tracked_;
+  std::vector<BackendInput> backend_inputs_;
+  std::vector<Estimate> estimates_;
+
+  // Loop state
+  Clock::time_point run_start_;
+  std::clock_t run_start_cpu_ = 0;
+  Clock::time_point loop_start_;
+  std::clock_t loop_start_cpu_ = 0;
+  bool cpu_clock_ = false;
+  bool have_imu_ = false;
+  TimeNs last_imu_cam_ = 0;
+  bool timing_started_ = false;
+  TimeNs last_timing_t_ = 0;
+  TimeNs t_now_ = 0;
+  bool any_item_ = false;
+  std::optional<io::EstimateStatus> pipeline_failure_;
+};
+
+void PipelineRun::setup() {
+  StageTimer timer(&result_.times.setup_s);
+  options_.validate();
+  if (!fs::is_directory(sequence_)) throw Error(sequence_ + ": not a folder");
+  method_ = options_.methodKind();
+  const MethodInfo& method = methodInfo(method_);
+  const bool eklt = method_ == Method::kEkltVio;
+
+  // Frames: needed by KLT and by EKLT on sensor frames; fused into the reconstruction when present.
+  const bool has_images = fs::exists(fs::path(sequence_) / "images.txt");
+  const std::vector<io::ImageStamp> images = has_images ? io::readImageList(sequence_) : std::vector<io::ImageStamp>{};
+  const bool frames_needed = method_ == Method::kKltVio || (eklt && options_.frontend.image_source == "frames");
+  if (frames_needed && images.empty())
+    throw Error(sequence_ + ": no frames (images.txt " + (has_images ? "is empty" : "missing") + ") for " +
+                options_.method + (eklt ? "; to track on frames reconstructed from events, run with "
+                                          "--set frontend.image_source=reconstructed"
+                                        : "; KLT-VIO needs frames"));
+  std::optional<cv::Size> first_frame_size;
+  if (!images.empty()) first_frame_size = io::readFrame(sequence_, images.front()).size();
+
+  rig_ = loadSequenceRig(sequence_, options_.calibration, options_.backend, first_frame_size);
+  result_.rig_source = rig_.source;
+  offset_ns_ = rig_.rig.time_offset_cam_imu_ns;
+  const CameraSensor& event_cam = rig_.eventCamera();
+  tracker_camera_ = method.tracks_frame_camera ? &rig_.frameCamera() : &event_cam;
+  result_.tracker_camera = tracker_camera_->name;
+  if (method.tracks_frame_camera && tracker_camera_ == &event_cam && rig_.source == "sensors.yaml" &&
+      rig_.rig.cameras.size() > 1)
+    result_.notes.push_back(options_.method + ": no frame camera in sensors.yaml; using the event camera's calibration");
+  // Frames go to the tracker camera (EKLT: the event camera, the DAVIS frames share its pixels).
+  const Camera& fc = tracker_camera_->camera;
+  frame_size_ = cv::Size(fc.width(), fc.height());
+  frame_size_from_ = rig_.describe(*tracker_camera_);
+  if (first_frame_size && method_ != Method::kTracks && *first_frame_size != frame_size_)
+    throw Error((fs::path(sequence_) / images.front().relative_path).string() + ": frame size " +
+                std::to_string(first_frame_size->width) + "x" + std::to_string(first_frame_size->height) +
+                " differs from " + frame_size_from_ + " (" + std::to_string(frame_size_.width) + "x" +
+                std::to_string(frame_size_.height) + ")");
+  setupReader(images);
+  setupStages();
+  writer_ = std::make_unique<EstimateWriter>(output_, options_.output, event_cam.T_B_C, offset_ns_,
+                                             std::vector<std::string>{"evio estimate " + sequence_ + " (" +
+                                                                      options_.method + ")"});
+}
+
+void PipelineRun::setupReader(const std::vector<io::ImageStamp>& images) {
+  const CameraSensor& event_cam = rig_.eventCamera();
+  SequenceReaderOptions ro;
+  ro.read_events = methodInfo(method_).reads_events;
+  ro.read_frames = method_ != Method::kTracks && !images.empty();
+  ro.read_imu = true;
+  ro.read_range = options_.backend.use_range;
+  if (options_.backend.use_range && !rig_.rig.range_finder)
+    throw Error("backend.use_range: " + rig_.source + " of " + sequence_ + " has no range finder");
+  if (options_.backend.use_range && !fs::exists(fs::path(sequence_) / "range.txt"))
+    throw Error("backend.use_range: " + (fs::path(sequence_) / "range.txt").string() + " not found");
+  ro.event_width = event_cam.camera.width();
+  ro.event_height = event_cam.camera.height();
+  ro.calibration = rig_.describe(event_cam);
+  ro.time_offset_cam_imu_ns = offset_ns_;
+  reader_ = std::make_unique<SequenceReader>(sequence_, ro);
+  result_.events_file = reader_->eventsFile();
+}
+
+void PipelineRun::setupStages() {
+  if (method_ == Method::kTracks) {
+    fs::path file(options_.tracks.file);
+    if (file.is_relative()) file = fs::path(sequence_) / file;
+    if (!fs::exists(file)) throw Error(file.string() + ": tracks file not found (tracks.file)");
+    auto input = std::make_unique<TracksInput>(file.string(), options_.tracks, options_.seed);
+    result_.notes.push_back("tracks: " + std::to_string(input->numSamples()) + " samples of " +
+                            std::to_string(input->numTracks()) + " tracks (" + std::to_string(input->numSplits()) +
+                            " split at gaps above tracks.max_gap_s)");
+    tracks_ = std::make_unique<TracksStage>(std::move(input));
+  } else {
+    prefilter_ = std::make_unique<PrefilterStage>(options_.frontend.prefilter, tracker_camera_->camera.width(),
+                                                  tracker_camera_->camera.height());
+    frontend_ = std::make_unique<FrontendStage>(options_.frontend, *tracker_camera_);
+    sync_ = std::make_unique<SynchronizerStage>(options_.sync);
+  }
+  backend_ = std::make_unique<Backend>(options_.backend, BackendSensors::fromRig(rig_.rig, tracker_camera_->name));
+  std::optional<GroundTruthInitializer> initializer;
+  if (options_.init.mode == "groundtruth") {
+    const std::string groundtruth = (fs::path(sequence_) / "groundtruth.txt").string();
+    if (!fs::exists(groundtruth))
+      throw Error(sequence_ + ": no groundtruth.txt for --init groundtruth; run with --init static");
+    initializer.emplace(groundtruth, options_.init.start_offset_s, options_.init.velocity_half_window_s,
+                        rig_.eventCamera().T_B_C, offset_ns_);
+  } else {
+    result_.notes.push_back("static initialisation: position and yaw zero, the estimate needs alignment");
+  }
+  backend_stage_ = std::make_unique<BackendStage>(*backend_, std::move(initializer));
+}
+
+void PipelineRun::runStages(SequenceItem& item) {
+  backend_inputs_.clear();
+  {
+    StageTimer timer(&result_.times.frontend_s);
+    if (tracks_) {
+      tracks_->process(item, backend_inputs_);
+    } else {
+      filtered_.clear();
+      tracked_.clear();
+      prefilter_->process(item, filtered_);
+      for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
+      for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs_);
+      if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
+    }
+  }
+  estimates_.clear();
+  {
+    StageTimer timer(&result_.times.backend_s);
+    for (BackendInput& in : backend_inputs_) backend_stage_->process(in, estimates_);
+  }
+  StageTimer timer(&result_.times.output_s);
+  for (const Estimate& e : estimates_) writer_->addEstimate(e);
+}
+
+void PipelineRun::afterItem(TimeNs t_ns) {
+  if (backend_->initialized() && !result_.initialization_t_ns)
+    result_.initialization_t_ns = backend_->state().imu.t_ns - offset_ns_;
+  // The IMU must keep up with the other streams: a run of data without IMU
+  // longer than imu_fail_gap_s after initialisation fails like a gap.
+  if (backend_->initialized() && backend_->status().ok() && have_imu_ && !pipeline_failure_ &&
+      nsToSeconds(t_ns - last_imu_cam_) > options_.backend.imu_fail_gap_s) {
+    io::EstimateStatus s;
+    s.code = io::EstimateStatus::Code::kFailed;
+    s.t_ns = last_imu_cam_;
+    s.cause = "no IMU reading after " + secondsText(last_imu_cam_) + " while data continue (gap above " +
+              "backend.imu_fail_gap_s)";
+    pipeline_failure_ = s;
+  }
+  if (result_.initialization_t_ns) writeTiming(t_ns);
+  if (progress_)
+    progress_(PipelineProgress{reader_->fraction(), t_ns, reader_->eventsRead(), backend_->initialized()});
+}
+
+void PipelineRun::writeTiming(TimeNs t_ns) {
+  const double processing = elapsed();
+  if (timing_started_ && !(t_ns > last_timing_t_ && nsToSeconds(t_ns - last_timing_t_) >= options_.output.timing_interval_s))
+    return;
+  const TimeNs t = timing_started_ ? t_ns : std::max(t_ns, *result_.initialization_t_ns);
+  if (timing_started_ && t <= last_timing_t_) return;
+  writer_->addTiming(io::TimingSample{t, processing, static_cast<std::int64_t>(reader_->eventsRead())});
+  timing_started_ = true;
+  last_timing_t_ = t;
+}
+
+void PipelineRun::loop() {
+  loop_start_ = Clock::now();
+  loop_start_cpu_ = std::clock();
+  cpu_clock_ = options_.output.timing_clock == "cpu";
+  SequenceItem item;
+  while (true) {
+    {
+      StageTimer timer(&result_.times.read_s);
+      if (!reader_->next(item)) break;
+      if (item.kind == SequenceItem::Kind::kFrame)
+        item.image = reader_->loadFrame(item.frame_index, frame_size_, frame_size_from_);
+    }
+    if (!any_item_) {
+      result_.t_first_ns = item.kind == SequenceItem::Kind::kEvents ? item.events.t().front() : item.t_ns;
+      any_item_ = true;
+    }
+    t_now_ = std::max(t_now_, item.t_ns);
+    if (item.kind == SequenceItem::Kind::kImu) {
+      ++result_.counts.imu_samples;
+      have_imu_ = true;
+      last_imu_cam_ = item.t_ns;
+    }
+    runStages(item);
+    afterItem(t_now_);
+    const bool stopped = !backend_->status().ok() || pipeline_failure_.has_value();
+    if (stopped && options_.output.stop_on_divergence) break;
+  }
+  result_.t_last_ns = t_now_;
+  if (prefilter_) {
+    result_.counts.events = prefilter_->numEventsSeen();
+    result_.counts.events_kept = prefilter_->numEventsKept();
+    result_.counts.frames = frontend_->numFrames();
+    result_.counts.track_points = sync_->numTrackPoints();
+  }
+  result_.counts.measurement_sets = backend_stage_->numMeasurementSets();
+}
+
+io::EstimateStatus PipelineRun::finalStatus() const {
+  io::EstimateStatus status;
+  const BackendStatus& bs = backend_->status();
+  if (!bs.ok()) {
+    status.code = bs.code;
+    status.t_ns = bs.t_ns - offset_ns_;
+    status.cause = bs.cause;
+  } else if (pipeline_failure_) {
+    status = *pipeline_failure_;
+  } else if (!backend_->initialized()) {
+    status.code = io::EstimateStatus::Code::kFailed;
+    status.t_ns = t_now_;
+    status.cause = options_.init.mode == "static"
+                       ? "never initialised: no still IMU window of backend.static_window_s"
+                       : "never initialised: no IMU reading at or after the initialisation time";
+  }
+  status.initialization_t_ns = result_.initialization_t_ns;
+  return status;
+}
+
+void PipelineRun::finish() {
+  if (timing_started_ && t_now_ > last_timing_t_)
+    writer_->addTiming(io::TimingSample{t_now_, elapsed(), static_cast<std::int64_t>(reader_->eventsRead())});
+  result_.backend = backend_->stats();
+  result_.counts.poses = writer_->numPoses();
+  result_.status = finalStatus();
+  {
+    StageTimer timer(&result_.times.output_s);
+    result_.times.total_s = std::chrono::duration<double>(Clock::now() - run_start_).count();
+    result_.times.cpu_s = static_cast<double>(std::clock() - run_start_cpu_) / CLOCKS_PER_SEC;
+    writer_->finish(result_.status, config::toYaml(options_), formatPipelineSummary(result_, options_));
+  }
+  result_.times.total_s = std::chrono::duration<double>(Clock::now() - run_start_).count();
+  result_.times.cpu_s = static_cast<double>(std::clock() - run_start_cpu_) / CLOCKS_PER_SEC;
+}
+
+}  // namespace
+
+PipelineResult runPipeline(const std::string& sequence, const PipelineOptions& options, const std::string& output,
+                           const PipelineProgressCallback& progress) {
+  PipelineRun run(sequence, options, output, progress);
+  return run.run();
+}
+
+}  // namespace evio::estimator

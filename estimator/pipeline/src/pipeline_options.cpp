@@ -1,0 +1,99 @@
+#include "evio/estimator/pipeline/pipeline_options.h"
+
+#include <cmath>
+#include <string>
+
+#include "evio/core/error.h"
+
+namespace evio::estimator {
+
+namespace {
+
+/// Runs a nested validate() and prefixes its message with the section name.
+template <class Options>
+void validateSection(const char* section, const Options& options) {
+  try {
+    options.validate();
+  } catch (const Error& e) {
+    throw Error(std::string(section) + "." + e.what());
+  }
+}
+
+}  // namespace
+
+void InitOptions::validate() const {
+  requireField(mode == "groundtruth" || mode == "static", "mode",
+               "must be groundtruth or static (got '" + mode + "'" +
+                   (mode == "auto" ? "; auto is gone: ground truth is used only when asked for" : "") + ")");
+  requireNonNegative("start_offset_s", start_offset_s);
+  requirePositive("velocity_half_window_s", velocity_half_window_s);
+}
+
+void CalibrationOptions::validate() const {
+  requireField(T_B_C.allFinite(), "T_B_C", "must be finite");
+  const Mat3 R = T_B_C.topLeftCorner<3, 3>();
+  requireField((R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-6 && R.determinant() > 0.0, "T_B_C",
+               "rotation block must be orthonormal with determinant +1 (within 1e-6)");
+  requireField((T_B_C.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() < 1e-12, "T_B_C",
+               "last row must be 0 0 0 1");
+  requirePositive("gravity_mps2", gravity_mps2);
+  requireInRange("time_offset_cam_imu_s", time_offset_cam_imu_s, -1.0, 1.0);
+  requirePositive("imu_rate_hz", imu_rate_hz);
+  requireField(width >= 0 && height >= 0, "width", "width and height must be >= 0");
+  requireField((width == 0) == (height == 0), "width", "width and height must both be 0 or both > 0");
+}
+
+void TracksInputOptions::validate() const {
+  requireField(!file.empty(), "file", "must not be empty");
+  requireNonNegative("noise_px", noise_px);
+  requireNonNegative("rate_hz", rate_hz);
+  requirePositive("max_gap_s", max_gap_s);
+}
+
+void PipelineOutputOptions::validate() const {
+  requirePositive("timing_interval_s", timing_interval_s);
+  requireField(timing_clock == "wall" || timing_clock == "cpu", "timing_clock",
+               "must be wall or cpu (got '" + timing_clock + "')");
+}
+
+void PipelineOptions::validate() const {
+  const std::optional<Method> m = parseMethod(method);
+  requireField(m.has_value(), "method", "must be one of " + methodNames() + " (got '" + method + "')");
+  validateSection("frontend", frontend);
+  validateSection("sync", sync);
+  validateSection("backend", backend);
+  validateSection("init", init);
+  validateSection("calibration", calibration);
+  validateSection("tracks", tracks);
+  validateSection("output", output);
+  const MethodInfo& info = methodInfo(*m);
+  if (*info.tracker)
+    requireField(frontend.tracker == info.tracker, "frontend.tracker",
+                 std::string("must be ") + info.tracker + " for method " + method + " (got '" + frontend.tracker +
+                     "')");
+  if (*info.tracker && !info.reads_events)
+    requireField(sync.trigger != "events", "sync.trigger",
+                 "must be track_time or fixed_rate for method " + method + " (" + info.tracker +
+                     " reads no events)");
+}
+
+Method PipelineOptions::methodKind() const {
+  const std::optional<Method> m = parseMethod(method);
+  if (!m) throw Error("method: must be one of " + methodNames() + " (got '" + method + "')");
+  return *m;
+}
+
+PipelineOptions PipelineOptions::forMethod(std::string_view method) {
+  const std::optional<Method> m = parseMethod(method);
+  if (!m) throw Error("method: must be one of " + methodNames() + " (got '" + std::string(method) + "')");
+  const MethodInfo& info = methodInfo(*m);
+  PipelineOptions o;
+  o.method = info.name;
+  if (*info.tracker) {
+    o.frontend.tracker = info.tracker;
+    o.sync.trigger = info.sync_trigger;
+  }
+  return o;
+}
+
+}  // namespace evio::estimator

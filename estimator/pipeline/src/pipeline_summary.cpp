@@ -1,0 +1,47 @@
+// summary.yaml of an estimate folder (pipeline.h): what ran, how long each
+// stage took and the backend's counters (each struct through its fields()).
+#include <yaml-cpp/yaml.h>
+
+#include "evio/core/io/config.h"
+#include "evio/estimator/pipeline/pipeline.h"
+
+namespace evio::estimator {
+
+namespace {
+
+void emitSeconds(YAML::Emitter& out, const char* key, double v) {
+  out << YAML::Key << key << YAML::Value;
+  config::detail::emitDouble(out, v);
+}
+
+}  // namespace
+
+std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions& options) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  out << YAML::Key << "method" << YAML::Value << options.method;
+  out << YAML::Key << "initialization" << YAML::Value << options.init.mode;
+  out << YAML::Key << "status" << YAML::Value << std::string(io::estimateStatusName(r.status.code));
+  out << YAML::Key << "calibration" << YAML::Value << r.rig_source;
+  out << YAML::Key << "tracker_camera" << YAML::Value << r.tracker_camera;
+  out << YAML::Key << "events_file" << YAML::Value << r.events_file;
+  emitSeconds(out, "data_start_s", nsToSeconds(r.t_first_ns));
+  emitSeconds(out, "data_end_s", nsToSeconds(r.t_last_ns));
+  if (r.initialization_t_ns) emitSeconds(out, "initialization_s", nsToSeconds(*r.initialization_t_ns));
+  const double data_s = nsToSeconds(r.t_last_ns - r.initialization_t_ns.value_or(r.t_first_ns));
+  emitSeconds(out, "data_after_initialization_s", data_s);
+  config::detail::Writer writer(out);
+  out << YAML::Key << "counts" << YAML::Value;
+  writer.write(r.counts);
+  out << YAML::Key << "stage_times_s" << YAML::Value;
+  writer.write(r.times);
+  out << YAML::Key << "backend" << YAML::Value;
+  writer.write(r.backend);
+  out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
+  for (const auto& n : r.notes) out << n;
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace evio::estimator

@@ -1,0 +1,121 @@
+#include "evio/estimator/pipeline/stages.h"
+
+#include <utility>
+
+namespace evio::estimator {
+
+// --- PrefilterStage ------------------------------------------------------------------
+
+PrefilterStage::PrefilterStage(const EventPrefilterOptions& options, int width, int height) {
+  if (!options.passThrough()) filter_ = std::make_unique<EventPrefilter>(options, width, height);
+}
+
+void PrefilterStage::process(SequenceItem& in, std::vector<SequenceItem>& out) {
+  if (in.kind == SequenceItem::Kind::kEvents) {
+    seen_ += in.events.size();
+    if (filter_) {
+      filter_->filter(in.events, 0, in.events.size(), &filtered_);
+      std::swap(in.events, filtered_);  // the spare buffer goes back with the item
+    }
+    kept_ += in.events.size();
+  }
+  out.emplace_back();
+  std::swap(out.back(), in);
+}
+
+// --- FrontendStage -------------------------------------------------------------------
+
+namespace {
+FrontendOptions withoutPrefilter(FrontendOptions options) {
+  options.prefilter = EventPrefilterOptions{};
+  return options;
+}
+}  // namespace
+
+FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera)
+    : frontend_(withoutPrefilter(options), camera.camera, camera.T_B_C) {}
+
+void FrontendStage::process(SequenceItem& in, std::vector<FrontendOutput>& out) {
+  FrontendOutput& o = out.emplace_back();
+  o.kind = in.kind;
+  o.t_ns = in.t_ns;
+  switch (in.kind) {
+    case SequenceItem::Kind::kEvents:
+      frontend_.addEvents(in.events);
+      o.events = in.events.size();
+      frontend_.drainTrackPoints(o.points);
+      break;
+    case SequenceItem::Kind::kFrame:
+      frontend_.addFrame(in.t_ns, in.image);
+      ++frames_;
+      frontend_.drainTrackPoints(o.points);
+      break;
+    case SequenceItem::Kind::kImu: {
+      ImuSample camera_clock = in.imu;
+      camera_clock.t_ns = in.t_ns;
+      frontend_.addImu(camera_clock);
+      o.imu = in.imu;
+      break;
+    }
+    case SequenceItem::Kind::kRange: o.range = in.range; break;
+  }
+}
+
+// --- SynchronizerStage ---------------------------------------------------------------
+
+void SynchronizerStage::process(FrontendOutput& in, std::vector<BackendInput>& out) {
+  if (!in.points.empty()) {
+    track_points_ += in.points.size();
+    sync_.addTrackPoints(in.points);
+  }
+  switch (in.kind) {
+    case SequenceItem::Kind::kEvents: sync_.addEvents(in.events, in.t_ns); break;
+    case SequenceItem::Kind::kFrame: sync_.advanceTime(in.t_ns); break;
+    case SequenceItem::Kind::kImu:
+      sync_.advanceTime(in.t_ns);
+      out.emplace_back(in.imu);
+      break;
+    case SequenceItem::Kind::kRange:
+      if (in.range.valid) out.emplace_back(RangeMeasurement{in.t_ns, in.range.range_m});
+      break;
+  }
+  MeasurementSet set;
+  while (sync_.poll(&set)) out.emplace_back(std::move(set));
+}
+
+// --- TracksStage ---------------------------------------------------------------------
+
+void TracksStage::process(SequenceItem& in, std::vector<BackendInput>& out) {
+  if (in.kind == SequenceItem::Kind::kRange && in.range.valid)
+    out.emplace_back(RangeMeasurement{in.t_ns, in.range.range_m});
+  if (in.kind != SequenceItem::Kind::kImu) return;
+  out.emplace_back(in.imu);
+  input_->advanceTo(in.t_ns, sets_);
+  for (MeasurementSet& s : sets_) out.emplace_back(std::move(s));
+  sets_.clear();
+}
+
+// --- BackendStage --------------------------------------------------------------------
+
+BackendStage::BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer)
+    : backend_(backend), initializer_(std::move(initializer)) {
+  if (!initializer_) backend_.setAutoStaticInitialization(true);
+}
+
+void BackendStage::process(BackendInput& in, std::vector<Estimate>& out) {
+  if (const auto* imu = std::get_if<ImuSample>(&in)) {
+    if (initializer_ && !backend_.initialized()) {
+      if (const std::optional<ImuState> x0 = initializer_->offer(imu->t_ns)) backend_.initialize(*x0);
+    }
+    backend_.addImu(*imu);
+  } else if (const auto* set = std::get_if<MeasurementSet>(&in)) {
+    backend_.addMeasurementSet(*set);
+    ++measurement_sets_;
+  } else {
+    const auto& range = std::get<RangeMeasurement>(in);
+    backend_.addRange(range.t_ns, range.range_m);
+  }
+  for (Estimate& e : backend_.takeEstimates()) out.push_back(std::move(e));
+}
+
+}  // namespace evio::estimator

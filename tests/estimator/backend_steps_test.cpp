@@ -1,0 +1,205 @@
+// The steps of one visual update (feature_selection.h) and the updaters'
+// shared services (updater.h, aux_updaters.h, slam_updater.h,
+// msckf_updater.h), each on its own, against exact answers.
+#include <gtest/gtest.h>
+
+#include <unordered_set>
+
+#include "evio/core/so3.h"
+#include "evio/estimator/backend/aux_updaters.h"
+#include "evio/estimator/backend/feature_selection.h"
+#include "evio/estimator/backend/msckf_updater.h"
+#include "evio/estimator/backend/slam_updater.h"
+
+namespace evio::estimator {
+namespace {
+
+const Camera kCamera = Camera(PinholeCamera(200, 100, Vec4(100, 100, 100, 50)));
+
+FeatureTrack track(FeatureId id, std::vector<std::int64_t> clone_ids) {
+  FeatureTrack t;
+  t.id = id;
+  for (const std::int64_t c : clone_ids) t.observations.push_back({c, Vec2::Zero()});
+  return t;
+}
+
+TrackMap tracksOf(std::vector<FeatureTrack> list) {
+  TrackMap out;
+  for (FeatureTrack& t : list) out[t.id] = std::move(t);
+  return out;
+}
+
+/// A state with clones 0..n-1 at the origin looking along +z, the IMU at rest,
+/// and P = diag(p_var).
+FilterState restingState(int clones, double p_var = 1e-2) {
+  FilterState s;
+  for (int i = 0; i < clones; ++i) {
+    CameraClone c;
+    c.id = i;
+    s.clones.push_back(c);
+  }
+  s.P = p_var * MatX::Identity(s.dim(), s.dim());
+  return s;
+}
+
+TEST(BackendSteps, UndistortObservationsGivesNormalisedCoordinatesOncePerFeature) {
+  MeasurementSet set;
+  set.features = {{1, Vec2(150, 75)}, {2, Vec2(100, 50)}, {1, Vec2(0, 0)}};
+  BackendStats stats;
+  const auto obs = undistortObservations(set, kCamera, &stats);
+  ASSERT_EQ(obs.size(), 2u);
+  EXPECT_EQ(obs[0].id, 1);
+  EXPECT_TRUE(obs[0].z.isApprox(Vec2(0.5, 0.25)));  // ((150−100)/100, (75−50)/100)
+  EXPECT_EQ(obs[1].id, 2);
+  EXPECT_TRUE(obs[1].z.isZero(0.0));
+  EXPECT_EQ(stats.features_undistort_failed, 0);
+}
+
+TEST(BackendSteps, ExtendTracksSkipsSlamFeaturesAndStartsNewTracks) {
+  FilterState state = restingState(1);
+  SlamFeature f;
+  f.id = 7;
+  state.features.push_back(f);
+  state.P = MatX::Identity(state.dim(), state.dim());
+  TrackMap tracks = tracksOf({track(3, {4})});
+  extendTracks({{3, Vec2(0.1, 0.2)}, {7, Vec2::Zero()}, {9, Vec2(0.3, 0.4)}}, state, 5, &tracks);
+  ASSERT_EQ(tracks.size(), 2u);
+  EXPECT_EQ(tracks.count(7), 0u);
+  ASSERT_EQ(tracks[3].observations.size(), 2u);
+  EXPECT_EQ(tracks[3].observations.back().clone_id, 5);
+  EXPECT_TRUE(tracks[3].observations.back().z.isApprox(Vec2(0.1, 0.2)));
+  ASSERT_EQ(tracks[9].observations.size(), 1u);
+  EXPECT_EQ(tracks[9].id, 9);
+}
+
+TEST(BackendSteps, SlamCandidatesAreTheLongestLiveTracksTiesByTheSmallerId) {
+  // Newest clone 10. Track 1 is lost (last seen in clone 9); 2 too short.
+  const TrackMap tracks = tracksOf({track(1, {5, 6, 7, 8, 9}), track(2, {9, 10}), track(3, {7, 8, 9, 10}),
+                                    track(4, {6, 7, 8, 9, 10}), track(5, {7, 8, 9, 10})});
+  EXPECT_EQ(chooseSlamCandidates(tracks, 10, 2, 3), (std::vector<FeatureId>{4, 3}));
+  EXPECT_EQ(chooseSlamCandidates(tracks, 10, 5, 3), (std::vector<FeatureId>{4, 3, 5}));
+  EXPECT_TRUE(chooseSlamCandidates(tracks, 10, 0, 3).empty());
+  EXPECT_EQ(chooseSlamCandidates(tracks, 10, 5, 2), (std::vector<FeatureId>{4, 3, 5, 2}));
+}
+
+TEST(BackendSteps, MsckfTracksAreThoseLeavingTheWindowAndTheLostOnes) {
+  // Oldest clone 0, newest 4. Track 1 starts in the oldest clone (leaves when
+  // sliding); 2 too; but 2 is a SLAM candidate; 3 is lost; 4 is lost and short;
+  // 5 is live and does not start in the oldest clone.
+  const TrackMap tracks = tracksOf({track(1, {0, 1, 2, 3, 4}), track(2, {0, 1, 2, 3, 4}), track(3, {1, 2, 3}),
+                                    track(4, {3}), track(5, {2, 3, 4})});
+  const std::unordered_set<FeatureId> slam{2};
+  MsckfChoice c = chooseMsckfTracks(tracks, 4, 0, true, slam, 3, true);
+  EXPECT_EQ(c.update, (std::vector<FeatureId>{1, 3}));
+  EXPECT_EQ(c.erase, (std::vector<FeatureId>{3, 4}));
+  c = chooseMsckfTracks(tracks, 4, 0, false, slam, 3, true);  // not sliding: lost tracks only
+  EXPECT_EQ(c.update, (std::vector<FeatureId>{3}));
+  c = chooseMsckfTracks(tracks, 4, 0, true, slam, 3, false);  // lost tracks erased, not used
+  EXPECT_EQ(c.update, (std::vector<FeatureId>{1}));
+  EXPECT_EQ(c.erase, (std::vector<FeatureId>{3, 4}));
+}
+
+TEST(BackendUpdaters, ConstrainRemovesTheYawDirectionExactlyOnce) {
+  FilterState state = restingState(2);
+  state.imu.p_W_B = Vec3(1, 2, 3);
+  state.imu.v_W = Vec3(0.5, -0.2, 0.1);
+  state.clones[1].p_fej = Vec3(0.3, 0.1, 0.0);
+  BackendOptions options;
+  options.observability_constraint = true;
+  BackendStats stats;
+  const ImuState fej = state.imu;
+  ZeroVelocityUpdater updater(UpdaterContext{&state, &fej, &options, &stats});
+  MatX H = MatX::Ones(3, state.dim());
+  updater.constrain(&H);
+  const VecX n = state.yawDirection(fej);
+  EXPECT_LT((H * n).norm(), 1e-12 * n.norm());
+  options.observability_constraint = false;
+  MatX H2 = MatX::Ones(3, state.dim());
+  updater.constrain(&H2);
+  EXPECT_TRUE(H2.isApprox(MatX::Ones(3, state.dim())));
+}
+
+TEST(BackendUpdaters, ZeroVelocityUpdateIsTheScalarKalmanGainPerAxis) {
+  // P_vv = p I, σ = s: v⁺ = v̂ s²/(p + s²), P_vv⁺ = p s²/(p + s²) (no cross terms).
+  FilterState state = restingState(0, 0.04);
+  state.imu.v_W = Vec3(1.0, -2.0, 0.5);
+  BackendOptions options;
+  options.observability_constraint = false;
+  options.zero_velocity_sigma_mps = 0.1;
+  BackendStats stats;
+  const ImuState fej = state.imu;
+  ZeroVelocityUpdater updater(UpdaterContext{&state, &fej, &options, &stats});
+  ASSERT_TRUE(updater.update());
+  const double k = 0.01 / (0.04 + 0.01);
+  EXPECT_TRUE(state.imu.v_W.isApprox(Vec3(1.0, -2.0, 0.5) * k, 1e-12));
+  EXPECT_NEAR(state.P(kIdxV, kIdxV), 0.04 * k, 1e-15);
+  EXPECT_NEAR(state.P(kIdxP, kIdxP), 0.04, 1e-15);  // uncorrelated: untouched
+  EXPECT_EQ(stats.zero_velocity_updates, 1);
+}
+
+TEST(BackendUpdaters, RangeOutsideTheSensorsSpanIsRejectedAndKeepsTheState) {
+  FilterState state = restingState(0);
+  BackendOptions options;
+  BackendStats stats;
+  const ImuState fej = state.imu;
+  RangeFinderSensor sensor;
+  sensor.min_range_m = 0.5;
+  sensor.max_range_m = 10.0;
+  const Chi2Table chi2(0.95);
+  RangeUpdater updater(UpdaterContext{&state, &fej, &options, &stats}, sensor, &chi2);
+  const MatX P = state.P;
+  EXPECT_TRUE(updater.update(20.0));
+  EXPECT_TRUE(updater.update(0.1));
+  EXPECT_EQ(stats.range_rejected, 2);
+  EXPECT_FALSE(updater.latestHit().has_value());
+  // In range but no SLAM features to form a plane: rejected, the hit point kept
+  // for depth priors (origin + 4 m along the beam, +z of B here).
+  EXPECT_TRUE(updater.update(4.0));
+  EXPECT_EQ(stats.range_rejected, 3);
+  ASSERT_TRUE(updater.latestHit().has_value());
+  EXPECT_TRUE(updater.latestHit()->second.isApprox(Vec3(0, 0, 4)));
+  EXPECT_TRUE(state.P.isApprox(P));
+}
+
+TEST(BackendUpdaters, SlamPruneDropsGatedOutAndNonFiniteFeatures) {
+  FilterState state = restingState(1);
+  for (FeatureId id = 0; id < 4; ++id) {
+    SlamFeature f;
+    f.id = id;
+    f.abr = Vec3(0.0, 0.0, 1.0);
+    state.features.push_back(f);
+  }
+  state.features[3].abr.z() = std::numeric_limits<double>::quiet_NaN();
+  state.P = MatX::Identity(state.dim(), state.dim());
+  BackendOptions options;
+  BackendStats stats;
+  const ImuState fej = state.imu;
+  const Chi2Table chi2(0.95);
+  SlamUpdater slam(UpdaterContext{&state, &fej, &options, &stats}, kCamera, 0.01, &chi2, &chi2, nullptr);
+  slam.prune({2, 0});
+  ASSERT_EQ(state.features.size(), 1u);
+  EXPECT_EQ(state.features[0].id, 1);
+  EXPECT_EQ(state.dim(), kImuDim + kCloneDim + kFeatureDim);
+  EXPECT_EQ(stats.slam_features_removed, 3);
+}
+
+TEST(BackendUpdaters, MsckfUsesEveryChosenTrackOnceAndCountsWhyNot) {
+  // Two clones with no baseline: no parallax for any track; each chosen track is emptied.
+  FilterState state = restingState(2);
+  BackendOptions options;
+  BackendStats stats;
+  const ImuState fej = state.imu;
+  const Chi2Table chi2(0.95);
+  MsckfUpdater msckf(UpdaterContext{&state, &fej, &options, &stats}, kCamera, 1e-4, &chi2);
+  TrackMap tracks = tracksOf({track(1, {0, 1}), track(2, {0, 1})});
+  const UpdateRows rows = msckf.residuals({1, 2}, &tracks);
+  EXPECT_EQ(rows.H.rows(), 0);
+  EXPECT_EQ(rows.H.cols(), state.dim());
+  EXPECT_EQ(msckf.lastCount(), 0);
+  EXPECT_EQ(stats.msckf_features_no_parallax + stats.msckf_triangulation_failed, 2);
+  EXPECT_TRUE(tracks[1].observations.empty());
+  EXPECT_TRUE(tracks[2].observations.empty());
+}
+
+}  // namespace
+}  // namespace evio::estimator

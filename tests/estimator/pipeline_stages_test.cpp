@@ -1,0 +1,152 @@
+// The pipeline's stages (stages.h) and method registry (method.h) on their
+// own: what each stage passes on, in which order, with exact answers.
+#include <gtest/gtest.h>
+
+#include <variant>
+
+#include "evio/core/error.h"
+#include "evio/core/io/tum.h"
+#include "evio/estimator/pipeline/method.h"
+#include "evio/estimator/pipeline/pipeline_options.h"
+#include "evio/estimator/pipeline/stages.h"
+#include "temp_dir.h"
+
+namespace evio::estimator {
+namespace {
+
+SequenceItem eventsItem(std::vector<std::pair<TimeNs, int>> t_x) {
+  SequenceItem item;
+  item.kind = SequenceItem::Kind::kEvents;
+  for (const auto& [t, x] : t_x) item.events.push_back(t, static_cast<std::uint16_t>(x), 5, true);
+  item.t_ns = item.events.t().back();
+  return item;
+}
+
+SequenceItem imuItem(TimeNs t_cam_ns, TimeNs offset_ns = 0) {
+  SequenceItem item;
+  item.kind = SequenceItem::Kind::kImu;
+  item.t_ns = t_cam_ns;
+  item.imu.t_ns = t_cam_ns + offset_ns;
+  item.imu.acc_B = Vec3(0, 0, 9.81);
+  return item;
+}
+
+TEST(PipelineMethods, EveryMethodParsesBackAndSetsItsFrontend) {
+  EXPECT_EQ(methodNames(), "eklt-vio, klt-vio, tracks");
+  for (const Method m : {Method::kEkltVio, Method::kKltVio, Method::kTracks}) {
+    const MethodInfo& info = methodInfo(m);
+    ASSERT_EQ(parseMethod(info.name), m);
+    const PipelineOptions o = PipelineOptions::forMethod(info.name);
+    EXPECT_EQ(o.methodKind(), m);
+    if (*info.tracker) {
+      EXPECT_EQ(o.frontend.tracker, info.tracker);
+      EXPECT_EQ(o.sync.trigger, info.sync_trigger);
+    }
+    EXPECT_NO_THROW(o.validate());
+  }
+  EXPECT_FALSE(parseMethod("haste").has_value());
+  EXPECT_THROW(PipelineOptions::forMethod("haste"), Error);
+  PipelineOptions o = PipelineOptions::forMethod("klt-vio");
+  o.frontend.tracker = "eklt";
+  EXPECT_THROW(o.validate(), Error);
+}
+
+TEST(PipelineStages, PrefilterPassesEverythingThroughWhenOffAndCountsWhatItDrops) {
+  PrefilterStage off(EventPrefilterOptions{}, 20, 10);
+  std::vector<SequenceItem> out;
+  SequenceItem in = eventsItem({{1000, 1}, {2000, 1}, {3000, 2}});
+  off.process(in, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].events.size(), 3u);
+  EXPECT_EQ(off.numEventsSeen(), 3u);
+  EXPECT_EQ(off.numEventsKept(), 3u);
+
+  EventPrefilterOptions refractory;
+  refractory.refractory_period_s = 0.5e-3;  // 0.5 ms per pixel
+  PrefilterStage on(refractory, 20, 10);
+  out.clear();
+  in = eventsItem({{1000, 1}, {200'000, 1}, {300'000, 2}, {900'000, 1}});
+  on.process(in, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].events.size(), 3u);  // pixel 1 at 0.2 ms falls in its refractory period
+  EXPECT_EQ(on.numEventsSeen(), 4u);
+  EXPECT_EQ(on.numEventsKept(), 3u);
+  SequenceItem imu = imuItem(1'000'000);
+  on.process(imu, out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1].kind, SequenceItem::Kind::kImu);
+  EXPECT_EQ(on.numEventsSeen(), 4u);
+}
+
+TEST(PipelineStages, SynchronizerPassesImuAndValidRangeBeforeTheSetsTheyRelease) {
+  SynchronizerOptions so;
+  so.trigger = "fixed_rate";
+  so.rate_hz = 100.0;  // a set every 10 ms
+  SynchronizerStage sync(so);
+  std::vector<BackendInput> out;
+  FrontendOutput points;
+  points.kind = SequenceItem::Kind::kFrame;
+  points.t_ns = 1'000'000;
+  points.points = {TrackPoint{1, 1'000'000, Vec2(3, 4), 1.0, TrackStatus::kNew}};
+  sync.process(points, out);
+  EXPECT_EQ(sync.numTrackPoints(), 1u);
+  FrontendOutput imu;
+  imu.kind = SequenceItem::Kind::kImu;
+  imu.t_ns = 25'000'000;
+  imu.imu.t_ns = 25'000'000;
+  out.clear();
+  sync.process(imu, out);
+  ASSERT_GE(out.size(), 2u);
+  EXPECT_TRUE(std::holds_alternative<ImuSample>(out[0]));
+  for (std::size_t i = 1; i < out.size(); ++i) EXPECT_TRUE(std::holds_alternative<MeasurementSet>(out[i]));
+  FrontendOutput range;
+  range.kind = SequenceItem::Kind::kRange;
+  range.t_ns = 26'000'000;
+  range.range = io::RangeSample{26'000'000, 2.5, true};
+  out.clear();
+  sync.process(range, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(std::get<RangeMeasurement>(out[0]).range_m, 2.5);
+  range.range.valid = false;
+  out.clear();
+  sync.process(range, out);
+  EXPECT_TRUE(out.empty());
+}
+
+TEST(PipelineStages, TracksStageReleasesTheSetsUpToEachImuTime) {
+  std::vector<io::TrackSample> samples;
+  for (int k = 0; k < 5; ++k) samples.push_back(io::TrackSample{1, k * 10'000'000, Vec2(10 + k, 10)});
+  TracksInputOptions o;
+  o.rate_hz = 0.0;  // every time in the file
+  TracksStage stage(std::make_unique<TracksInput>(samples, o, 1));
+  std::vector<BackendInput> out;
+  SequenceItem imu = imuItem(25'000'000);
+  stage.process(imu, out);
+  ASSERT_EQ(out.size(), 4u);  // the IMU, then the sets at 0, 10 and 20 ms
+  EXPECT_TRUE(std::holds_alternative<ImuSample>(out[0]));
+  EXPECT_EQ(std::get<MeasurementSet>(out[3]).t_ns, 20'000'000);
+}
+
+TEST(PipelineStages, GroundTruthInitializerWaitsForItsTimeAndStartsFromTheTruth) {
+  test::TempDir dir;
+  const std::string gt = dir.file("groundtruth.txt");
+  Trajectory truth;
+  for (int k = 0; k <= 100; ++k)  // 1 m/s along x, from 0.1 s
+    truth.push_back(StampedPose{100'000'000 + k * 10'000'000, Pose(Quat::Identity(), Vec3(0.01 * k, 0, 0))});
+  io::writeTum(gt, truth);
+  const TimeNs offset = 3'000'000;  // t_imu = t_cam + 3 ms
+  GroundTruthInitializer init(gt, 0.2, 0.01, Pose(), offset);
+  EXPECT_FALSE(init.offer(50'000'000 + offset).has_value());  // before the truth: waits for 0.1 + 0.2 s
+  EXPECT_FALSE(init.offer(299'000'000 + offset).has_value());
+  const std::optional<ImuState> x0 = init.offer(300'000'000 + offset);
+  ASSERT_TRUE(x0.has_value());
+  EXPECT_EQ(x0->t_ns, 300'000'000 + offset);
+  EXPECT_TRUE(x0->p_W_B.isApprox(Vec3(0.2, 0, 0), 1e-12));
+  EXPECT_TRUE(x0->v_W.isApprox(Vec3(1.0, 0, 0), 1e-9));
+  GroundTruthInitializer late(gt, 5.0, 0.01, Pose(), 0);
+  EXPECT_FALSE(late.offer(100'000'000).has_value());
+  EXPECT_THROW(late.offer(5'200'000'000), Error);  // the truth ends at 1.1 s
+}
+
+}  // namespace
+}  // namespace evio::estimator

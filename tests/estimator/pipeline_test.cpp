@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "evio/core/io/atomic_file.h"
@@ -27,8 +29,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// A method's defaults started from the ground truth (the paper's protocol,
+/// which a run gets only when it asks for it).
+PipelineOptions fromGroundTruth(std::string_view method) {
+  PipelineOptions o = PipelineOptions::forMethod(method);
+  o.init.mode = "groundtruth";
+  return o;
+}
+
 PipelineOptions tracksOptions(double noise_px = 0.5) {
-  PipelineOptions o = PipelineOptions::forMethod("tracks");
+  PipelineOptions o = fromGroundTruth("tracks");
   o.tracks.noise_px = noise_px;
   o.backend.sigma_img_px = 1.0;
   o.backend.slam_min_depth_m = 1.5;  // the landmarks are 2-5 m away
@@ -70,8 +80,8 @@ TEST(Pipeline, TracksMethodFollowsTheGroundTruthAndWritesTheEstimateFolder) {
   ASSERT_TRUE(r.status.ok()) << r.status.cause;
   ASSERT_TRUE(r.initialization_t_ns.has_value());
   EXPECT_EQ(*r.initialization_t_ns, 0);
-  EXPECT_EQ(r.measurement_sets, 80u);  // 20 Hz over 4 s
-  EXPECT_EQ(r.poses, 80u);
+  EXPECT_EQ(r.counts.measurement_sets, 80u);  // 20 Hz over 4 s
+  EXPECT_EQ(r.counts.poses, 80u);
   EXPECT_GT(r.backend.slam_initialized_prior + r.backend.slam_initialized_triangulated, 0);
   // Initialised from ground truth, the estimate stays within 5 cm over 4 s
   // (0.5 px noise, six_dof motion of a few cm and degrees).
@@ -194,7 +204,7 @@ TEST(PipelineBadInput, ImuEndingWhileFramesContinueFails) {
   so.frames = 60;
   so.imu_end_s = 1.0;
   writeTinySequence(seq, so);
-  const PipelineResult r = runPipeline(seq, PipelineOptions::forMethod("klt-vio"), dir.file("out"));
+  const PipelineResult r = runPipeline(seq, fromGroundTruth("klt-vio"), dir.file("out"));
   EXPECT_EQ(r.status.code, io::EstimateStatus::Code::kFailed);
   EXPECT_NE(r.status.cause.find("no IMU reading after"), std::string::npos) << r.status.cause;
 }
@@ -209,7 +219,7 @@ TEST(PipelineBadInput, EventsOutOfOrderNameTheFileAndLine) {
   so.frames = 10;
   writeTinySequence(seq, so);
   io::writeFileAtomic(seq + "/events.txt", "0.001 10 10 1\n0.002 11 10 0\n0.0015 12 10 1\n0.003 13 10 1\n");
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("eklt-vio"), dir.file("out")); },
                         {"events.txt:3"});
   EXPECT_FALSE(fs::exists(dir.file("out/trajectory.txt")));  // nothing half-written
 }
@@ -221,12 +231,12 @@ TEST(PipelineBadInput, NoFramesForFrameBasedTrackingSaysWhatToDo) {
   so.duration_s = 1.0;
   so.events = true;
   writeTinySequence(seq, so);
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("eklt-vio"), dir.file("out")); },
                         {"no frames", "frontend.image_source=reconstructed"});
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("klt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("klt-vio"), dir.file("out")); },
                         {"no frames", "KLT-VIO needs frames"});
   // The documented alternative runs.
-  PipelineOptions o = PipelineOptions::forMethod("eklt-vio");
+  PipelineOptions o = fromGroundTruth("eklt-vio");
   o.frontend.image_source = "reconstructed";
   EXPECT_NO_THROW(runPipeline(seq, o, dir.file("out")));
 }
@@ -241,9 +251,9 @@ TEST(PipelineBadInput, FrameSizeNotTheCalibrationsNamesBoth) {
   so.frame_height = 150;
   so.events = true;
   writeTinySequence(seq, so);
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("klt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("klt-vio"), dir.file("out")); },
                         {"200x150", "240x180", "sensors.yaml camera frames"});
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("eklt-vio"), dir.file("out")); },
                         {"200x150", "240x180", "sensors.yaml camera cam0"});
 }
 
@@ -260,12 +270,12 @@ TEST(PipelineBadInput, EventSensorSizeNotTheCalibrationsNamesBoth) {
   h5.width = 346;
   h5.height = 260;
   io::writeEventsH5(seq + "/events.h5", events, h5);
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("eklt-vio"), dir.file("out")); },
                         {"events.h5", "346x260", "240x180"});
   // events.txt with a pixel outside the calibrated sensor.
   fs::remove(seq + "/events.h5");
   io::writeFileAtomic(seq + "/events.txt", "0.001 10 10 1\n0.002 300 10 0\n");
-  expectErrorContaining([&] { runPipeline(seq, PipelineOptions::forMethod("eklt-vio"), dir.file("out")); },
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("eklt-vio"), dir.file("out")); },
                         {"events.txt:2", "240x180"});
 }
 
@@ -277,14 +287,43 @@ TEST(PipelineBadInput, InitialisationNeedsGroundTruthOrStaticMode) {
   so.groundtruth = false;
   writeTinySequence(seq, so);
   expectErrorContaining([&] { runPipeline(seq, tracksOptions(), dir.file("out")); },
-                        {"no groundtruth.txt", "init.mode=static"});
-  // auto → static; the hand-held motion is never still, so the run ends "failed" (not initialised).
+                        {"no groundtruth.txt", "--init static"});
+  // static: the hand-held motion is never still, so the run ends "failed" (not initialised).
   PipelineOptions o = tracksOptions();
-  o.init.mode = "auto";
+  o.init.mode = "static";
   const PipelineResult r = runPipeline(seq, o, dir.file("out"));
   EXPECT_EQ(r.status.code, io::EstimateStatus::Code::kFailed);
   EXPECT_NE(r.status.cause.find("never initialised"), std::string::npos) << r.status.cause;
-  EXPECT_EQ(r.poses, 0u);
+  EXPECT_EQ(r.counts.poses, 0u);
+  // `auto` is gone: it used to pick ground truth whenever the file existed.
+  o.init.mode = "auto";
+  expectErrorContaining([&] { runPipeline(seq, o, dir.file("out")); }, {"init.mode", "auto is gone"});
+}
+
+TEST(Pipeline, GroundTruthIsReadOnlyWhenAskedFor) {
+  // A sequence that ships ground truth: the default (static) never reads it,
+  // so the hand-held run cannot initialise; asked for, it starts from it. The
+  // resolved configuration and the summary say which ran.
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 2.0;
+  writeTinySequence(seq, so);
+  PipelineOptions o = PipelineOptions::forMethod("tracks");
+  EXPECT_EQ(o.init.mode, "static");
+  const PipelineResult r_static = runPipeline(seq, o, dir.file("static"));
+  EXPECT_EQ(r_static.status.code, io::EstimateStatus::Code::kFailed);
+  EXPECT_FALSE(r_static.initialization_t_ns.has_value());
+  const PipelineResult r_gt = runPipeline(seq, tracksOptions(), dir.file("gt"));
+  EXPECT_EQ(r_gt.status.code, io::EstimateStatus::Code::kOk);
+  EXPECT_TRUE(r_gt.initialization_t_ns.has_value());
+  const auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_NE(read(dir.file("static/config.yaml")).find("mode: static"), std::string::npos);
+  EXPECT_NE(read(dir.file("gt/config.yaml")).find("mode: groundtruth"), std::string::npos);
+  EXPECT_NE(read(dir.file("gt/summary.yaml")).find("initialization: groundtruth"), std::string::npos);
 }
 
 TEST(Pipeline, UseRangeFeedsEveryValidRangeReadingToTheBackend) {

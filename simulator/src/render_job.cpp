@@ -7,6 +7,7 @@
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/stopwatch.h"
+#include "evio/core/version.h"
 #include "evio/simulator/render_output.h"
 
 namespace evio::simulator {
@@ -41,7 +42,7 @@ RenderJobReport runRenderJob(const RenderJob& job) {
   std::ostringstream s;
   s.precision(17);
   const Pose& T = report.T_W_C;
-  s << "# written by evio 0.1.0 (evio render)\n";
+  s << "# written by " << evioVersion() << " (evio render)\n";
   s << "scene_file: \"" << job.scene_file << "\"\n";
   s << "rig_file: \"" << job.rig_file << "\"\n";
   s << "camera: \"" << sensor->name << "\"\n";

@@ -6,13 +6,12 @@
 #include <filesystem>
 
 #include "evio/core/error.h"
+#include "evio/core/version.h"
 #include "evio/trajectories/trajectory_factory.h"
 
 namespace evio::simulator {
 
 namespace fs = std::filesystem;
-
-const char* evioVersion() { return "evio 0.1.0"; }
 
 namespace {
 

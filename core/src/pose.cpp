@@ -1,5 +1,6 @@
 #include "evio/core/pose.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "evio/core/so3.h"
@@ -34,6 +35,17 @@ Vec6 Pose::log() const {
   xi.head<3>() = so3::leftJacobianInverse(phi) * p_;
   xi.tail<3>() = phi;
   return xi;
+}
+
+Pose interpolatePose(const StampedPose& a, const StampedPose& b, TimeNs t_ns) {
+  const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+  return Pose(a.pose.quaternion().slerp(s, b.pose.quaternion()),
+              (1.0 - s) * a.pose.translation() + s * b.pose.translation());
+}
+
+Trajectory::const_iterator firstPoseAtOrAfter(const Trajectory& trajectory, TimeNs t_ns) {
+  return std::lower_bound(trajectory.begin(), trajectory.end(), t_ns,
+                          [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
 }
 
 double angleBetween(const Quat& a, const Quat& b) { return so3::log(a.conjugate() * b).norm(); }

@@ -6,7 +6,6 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -16,6 +15,7 @@
 #include "commands.h"
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
+#include "evio/core/stopwatch.h"
 #include "evio/experiments/campaign.h"
 #include "evio/experiments/campaign_results.h"
 #include "evio/experiments/campaign_runner.h"
@@ -38,7 +38,7 @@ class OutcomePrinter {
   void operator()(const experiments::CampaignProgress& p) {
     if (!p.last) return;
     const std::size_t done = p.skipped + p.finished;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double elapsed = watch_.seconds();
     const std::size_t left = p.total - done;
     const double eta_s = p.finished > 0 ? elapsed / static_cast<double>(p.finished) * static_cast<double>(left) : 0.0;
     char eta[32];
@@ -52,7 +52,7 @@ class OutcomePrinter {
   }
 
  private:
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  Stopwatch watch_;
 };
 
 }  // namespace

@@ -78,7 +78,7 @@ void addEstimateCommand(CLI::App& app) {
       if (!m.IsDefined() || !m.IsScalar())
         throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|tracks or method: in " +
                     (args->config.empty() ? std::string("--set") : args->config));
-      args->method = config::detail::scalarAs<std::string>(doc, m, "method");
+      args->method = config::scalarAs<std::string>(doc, m, "method");
       try {
         (void)estimator::PipelineOptions::forMethod(args->method);  // the one list of methods
       } catch (const Error& e) {

@@ -5,11 +5,12 @@
 
 #include "commands.h"
 #include "evio/core/error.h"
+#include "evio/core/version.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"evio: event-camera visual-inertial odometry test bench (simulate, estimate, evaluate)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "evio 0.1.0");
+  app.set_version_flag("--version", evio::evioVersion());
   evio::apps::addInfoCommand(app);
   evio::apps::addTrajectoryCommand(app);
   evio::apps::addRenderCommand(app);

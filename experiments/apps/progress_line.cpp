@@ -30,18 +30,15 @@ std::string duration(double s) {
 ProgressLine::ProgressLine(std::string label, std::string unit, bool quiet)
     : label_(std::move(label)),
       unit_(std::move(unit)),
-      enabled_(!quiet && ::isatty(STDERR_FILENO)),
-      start_(std::chrono::steady_clock::now()),
-      last_(start_) {}
+      enabled_(!quiet && ::isatty(STDERR_FILENO)) {}
 
 ProgressLine::~ProgressLine() { finish(); }
 
 void ProgressLine::update(double fraction, double amount) {
   if (!enabled_) return;
-  const auto now = std::chrono::steady_clock::now();
-  if (shown_ && now - last_ < std::chrono::milliseconds(200)) return;
-  last_ = now;
-  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  const double elapsed = watch_.seconds();
+  if (shown_ && elapsed - last_s_ < 0.2) return;
+  last_s_ = elapsed;
   const double rate = elapsed > 0 ? amount / elapsed : 0.0;
   const double eta =
       fraction > 1e-6 ? elapsed * (1.0 - fraction) / fraction : std::numeric_limits<double>::quiet_NaN();

@@ -4,8 +4,9 @@
 /// and ETA, refreshed at most every 0.2 s. Silent when stderr is not a
 /// terminal or when quiet, so scripts and logs stay clean.
 
-#include <chrono>
 #include <string>
+
+#include "evio/core/stopwatch.h"
 
 namespace evio::apps {
 
@@ -27,8 +28,8 @@ class ProgressLine {
   std::string unit_;
   bool enabled_;
   bool shown_ = false;
-  std::chrono::steady_clock::time_point start_;
-  std::chrono::steady_clock::time_point last_;
+  Stopwatch watch_;     ///< since construction
+  double last_s_ = 0.0;  ///< watch_ time of the last refresh, s
 };
 
 }  // namespace evio::apps

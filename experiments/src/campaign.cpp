@@ -17,8 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using config::Document;
-using config::detail::scalarAs;
-using config::detail::throwAt;
+using config::scalarAs;
+using config::throwAt;
 
 const std::set<std::string> kPlaceholders = {"evio",     "bin",      "campaign_dir", "scenario", "scenario_file",
                                              "method",   "seed",     "sequence",     "job",      "simulate_set",

@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <csignal>
-#include <chrono>
 #include <ctime>
 #include <exception>
 #include <filesystem>
@@ -21,6 +20,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
+#include "evio/core/stopwatch.h"
 #include "evio/experiments/child_process.h"
 #include "evio/experiments/json_value.h"
 
@@ -213,7 +213,7 @@ fs::path estimateDonor(const fs::path& results, const Job& job, const std::strin
 }
 
 JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, RunContext& ctx) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   const std::string started = nowIso();
   const fs::path results(o.results);
   const fs::path final_dir = results / "jobs" / job.id;
@@ -284,7 +284,7 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
   const JsonValue* status = m.find("status");
   outcome.status = status && !status->text().empty() ? status->text() : "failed";
   if (const JsonValue* cs = m.find("cause")) outcome.cause = cs->text();
-  outcome.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  outcome.wall_s = watch.seconds();
   io::writeFileAtomic((staging / "job.yaml").string(),
                       jobYaml(c, job, vars["sequence"], outcome, steps, started));
   if (o.retry_failed && fs::exists(final_dir)) fs::remove_all(final_dir);

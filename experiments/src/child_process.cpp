@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "evio/core/error.h"
+#include "evio/core/stopwatch.h"
 
 namespace evio::experiments {
 
@@ -47,7 +48,7 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::string& cw
     throw Error("runChild: pipe failed");
   }
   const pid_t parent = ::getpid();
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(log_fd);
@@ -88,7 +89,7 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::string& cw
       r.error = std::string("waitpid failed: ") + std::strerror(errno);
       return r;
     }
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double elapsed = watch.seconds();
     if (timeout_s > 0.0 && elapsed > timeout_s && !r.timed_out) {
       r.timed_out = true;
       ::kill(-pid, SIGKILL);
@@ -99,7 +100,7 @@ ChildResult runChild(const std::vector<std::string>& argv, const std::string& cw
       sleep = std::min(sleep * 2, std::chrono::milliseconds(50));
     }
   }
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.wall_s = watch.seconds();
   if (got == static_cast<ssize_t>(sizeof(exec_errno))) {
     r.error = argv[0] + ": " + std::strerror(exec_errno);
     return r;

@@ -1,6 +1,5 @@
 #include "evio/experiments/track_sequence.h"
 
-#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -13,6 +12,7 @@
 #include "evio/core/io/images_txt.h"
 #include "evio/core/io/imu_txt.h"
 #include "evio/core/io/sensors_yaml.h"
+#include "evio/core/stopwatch.h"
 
 namespace evio::experiments {
 
@@ -139,9 +139,9 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
     while (next_imu < imu.size() && imu[next_imu].t_ns <= t) frontend.addImu(imu[next_imu++]);
   };
   const auto run = [&](auto&& fn) {
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch watch;
     fn();
-    busy += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    busy += watch.seconds();
   };
   EventArray chunk;
   const auto feedEventsUntil = [&](std::optional<TimeNs> t_end) {

@@ -15,8 +15,7 @@ void AssociationOptions::validate() const {
 
 bool interpolatePose(const Trajectory& gt, TimeNs t_ns, TimeNs max_difference_ns, Pose* pose) {
   require(!gt.empty(), "interpolatePose: empty ground truth");
-  const auto after = std::lower_bound(gt.begin(), gt.end(), t_ns,
-                                      [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
+  const auto after = firstPoseAtOrAfter(gt, t_ns);
   if (after == gt.end()) {  // after the last sample
     if (t_ns - gt.back().t_ns > max_difference_ns) return false;
     *pose = gt.back().pose;
@@ -30,10 +29,7 @@ bool interpolatePose(const Trajectory& gt, TimeNs t_ns, TimeNs max_difference_ns
   const StampedPose& a = *(after - 1);
   const StampedPose& b = *after;
   if (std::min(t_ns - a.t_ns, b.t_ns - t_ns) > max_difference_ns) return false;
-  const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  const Vec3 p = (1.0 - s) * a.pose.translation() + s * b.pose.translation();
-  const Quat q = a.pose.quaternion().slerp(s, b.pose.quaternion());
-  *pose = Pose(q, p);
+  *pose = evio::interpolatePose(a, b, t_ns);
   return true;
 }
 

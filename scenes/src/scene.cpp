@@ -2,7 +2,6 @@
 
 #include <tbb/task_arena.h>
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -13,6 +12,7 @@
 #include "evio/core/error.h"
 #include "evio/core/io/mesh_file.h"
 #include "evio/core/random_stream.h"
+#include "evio/core/stopwatch.h"
 #include "evio/scenes/embree_util.h"
 #include "evio/scenes/heightmap.h"
 #include "evio/scenes/irradiance_cache.h"
@@ -25,10 +25,6 @@
 namespace evio::scenes {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 tbb::task_arena makeArena(int threads) {
   return threads > 0 ? tbb::task_arena(threads) : tbb::task_arena();
@@ -84,18 +80,18 @@ Scene::Scene(const SceneDescription& description, const SceneBuildOptions& optio
     }
     direct_.push_back(d);
   }
-  auto t0 = std::chrono::steady_clock::now();
+  Stopwatch watch;
   generate(options);
-  stats_.generate_s = secondsSince(t0);
-  t0 = std::chrono::steady_clock::now();
+  stats_.generate_s = watch.seconds();
+  watch.restart();
   buildEmbree(options);
   buildShadeMeshes();
-  stats_.bvh_s = secondsSince(t0);
+  stats_.bvh_s = watch.seconds();
   if (o.indirect.bounces > 0) {
-    t0 = std::chrono::steady_clock::now();
+    watch.restart();
     indirect_ = computeIrradianceCache(*this, o.indirect, o.seed, options.threads);
     indirect_on_ = true;
-    stats_.indirect_s = secondsSince(t0);
+    stats_.indirect_s = watch.seconds();
   }
 }
 

@@ -123,7 +123,7 @@ SceneDescription loadSceneDocument(const Document& doc, const std::string& base_
   SceneDescription d;
   d.file = doc.file;
   d.base_dir = base_dir;
-  config::detail::readValue(doc, root, "", d.options);
+  config::readValue(doc, root, "", d.options);
   SceneOptions& o = d.options;
 
   const auto element = [&](const char* list, std::size_t i) { return root[list][i]; };

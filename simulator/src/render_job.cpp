@@ -1,12 +1,13 @@
 #include "evio/simulator/render_job.h"
 
-#include <chrono>
 #include <filesystem>
 #include <sstream>
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/sensors_yaml.h"
+#include "evio/core/stopwatch.h"
+#include "evio/core/version.h"
 #include "evio/simulator/render_output.h"
 
 namespace evio::simulator {
@@ -30,9 +31,9 @@ RenderJobReport runRenderJob(const RenderJob& job) {
   report.stats = scene.stats();
   report.T_W_C = job.T_W_C ? *job.T_W_C : previewPose(description);
   const Renderer renderer(scene, sensor->camera, job.renderer);
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   const RenderOutput out = renderer.render(report.T_W_C, job.velocity ? &*job.velocity : nullptr);
-  report.render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  report.render_s = watch.seconds();
 
   const double white = job.white_w_m2_sr > 0.0 ? job.white_w_m2_sr : autoWhite(out.radiance);
   report.files = writeRenderOutput(job.out_dir, out, white);
@@ -41,7 +42,7 @@ RenderJobReport runRenderJob(const RenderJob& job) {
   std::ostringstream s;
   s.precision(17);
   const Pose& T = report.T_W_C;
-  s << "# written by evio 0.1.0 (evio render)\n";
+  s << "# written by " << evioVersion() << " (evio render)\n";
   s << "scene_file: \"" << job.scene_file << "\"\n";
   s << "rig_file: \"" << job.rig_file << "\"\n";
   s << "camera: \"" << sensor->name << "\"\n";

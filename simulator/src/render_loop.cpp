@@ -1,13 +1,12 @@
 #include "render_loop.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <ctime>
 #include <limits>
 #include <optional>
 
 #include "evio/core/error.h"
+#include "evio/core/stopwatch.h"
 #include "evio/simulator/adaptive_sampler.h"
 #include "evio/simulator/event_camera.h"
 #include "evio/simulator/frame_camera.h"
@@ -18,11 +17,6 @@ namespace evio::simulator {
 namespace {
 
 constexpr TimeNs kNever = std::numeric_limits<TimeNs>::max();
-
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-/// Process CPU time (all threads) since c0, s.
-double cpuSecondsSince(std::clock_t c0) { return static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC; }
 
 /// Velocity of a camera C rigidly mounted at T_B_C, in C, from the body's state:
 ///   ṗ_W_C = v_W + R_W_B (ω_B × p_B_C),  v_C = R_W_Cᵀ ṗ_W_C,  ω_C = R_B_Cᵀ ω_B.
@@ -136,9 +130,9 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
     const Camera c = scenario.frameCamera();
     if (fo.meter_first_exposure) {
       const Pose T_W_F = trajectory.evaluate(scenario.start_ns).T_W_B * T_B_F;
-      const auto t0 = Clock::now();
+      const Stopwatch watch;
       const RenderOutput view = (separate ? *frame_renderer : renderer).render(T_W_F);
-      stats->frame_render_s += secondsSince(t0);
+      stats->frame_render_s += watch.seconds();
       ++stats->frame_renders;
       fco.exposure_s = meteredExposure(view.radiance, fco, FrameCamera(c.width(), c.height(), fco, o.seed));
     }
@@ -176,12 +170,12 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   const auto addSample = [&](const cv::Mat& radiance) {
     frame->images.push_back(radiance);
     if (frame->images.size() < frame->sample_ns.size()) return;
-    auto t0 = Clock::now();
+    Stopwatch watch;
     const Frame captured = frame_cam->capture(frame->start_ns, frame->images);
-    stats->frame_s += secondsSince(t0);
-    t0 = Clock::now();
+    stats->frame_s += watch.seconds();
+    watch.restart();
     writer.appendFrame(captured.t_ns, captured.image);
-    stats->write_s += secondsSince(t0);
+    stats->write_s += watch.seconds();
     frame.reset();
     ++frame_k;
   };
@@ -201,9 +195,9 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
 
     if (separate && t_frame <= t) {  // a separate frame camera's own sub-sample
       const Pose T_W_F = trajectory.evaluate(t_frame).T_W_B * T_B_F;
-      const auto t0 = Clock::now();
+      const Stopwatch watch;
       RenderOutput out = frame_renderer->render(T_W_F);
-      stats->frame_render_s += secondsSince(t0);
+      stats->frame_render_s += watch.seconds();
       ++stats->frame_renders;
       addSample(out.radiance);
       continue;
@@ -213,40 +207,40 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
       const TrajectoryState state = trajectory.evaluate(t);
       const Pose T_W_E = state.T_W_B * T_B_E;
       const CameraVelocity velocity = cameraVelocity(state, T_B_E);
-      auto t0 = Clock::now();
-      std::clock_t c0 = std::clock();
+      Stopwatch watch;
+      double cpu0_s = Stopwatch::processCpuSeconds();
       renderer.render(T_W_E, &velocity, &last);  // reuses last's images unless they are shared
-      stats->render_s += secondsSince(t0);
-      stats->render_cpu_s += cpuSecondsSince(c0);
+      stats->render_s += watch.seconds();
+      stats->render_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
       ++stats->renders;
 
-      t0 = Clock::now();
-      c0 = std::clock();
+      watch.restart();
+      cpu0_s = Stopwatch::processCpuSeconds();
       batch.clear();
       labels.clear();
       events_cam.update(t, last.radiance, &batch, &labels);
-      stats->event_s += secondsSince(t0);
-      stats->event_cpu_s += cpuSecondsSince(c0);
+      stats->event_s += watch.seconds();
+      stats->event_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
 
-      t0 = Clock::now();
+      watch.restart();
       writer.appendEvents(batch, labels);
-      stats->write_s += secondsSince(t0);
+      stats->write_s += watch.seconds();
       if (last_t == kNever) {
         result.first_depth = last.depth.clone();
         result.first_T_W_E = T_W_E;
       }
       last_t = t;
       if (t < scenario.end_ns) {  // the next step, predicted from this (latest) sample
-        t0 = Clock::now();
+        watch.restart();
         next_event = t + predictor.interval(last.radiance, last.flow);
-        stats->schedule_s += secondsSince(t0);
+        stats->schedule_s += watch.seconds();
       }
     }
     if (!separate && frame && t == t_frame) addSample(last.radiance);
     if (frame && t == t_depth) {
-      const auto t0 = Clock::now();
+      const Stopwatch watch;
       writer.appendDepth(frame->index, t, last.depth, o.output.flow_at_frames ? last.flow : cv::Mat());
-      stats->write_s += secondsSince(t0);
+      stats->write_s += watch.seconds();
       frame->depth_done = true;
     }
     if (progress)

@@ -6,13 +6,12 @@
 #include <filesystem>
 
 #include "evio/core/error.h"
+#include "evio/core/version.h"
 #include "evio/trajectories/trajectory_factory.h"
 
 namespace evio::simulator {
 
 namespace fs = std::filesystem;
-
-const char* evioVersion() { return "evio 0.1.0"; }
 
 namespace {
 
@@ -70,17 +69,17 @@ config::Document sectionDocument(const config::Document& doc, const YAML::Node& 
     preset_path = node.Scalar();
   } else if (node.IsMap()) {
     for (auto it = node.begin(); it != node.end(); ++it) {
-      if (!it->first.IsScalar()) config::detail::throwAt(doc, it->first, section, "keys must be plain strings");
+      if (!it->first.IsScalar()) config::throwAt(doc, it->first, section, "keys must be plain strings");
       if (it->first.Scalar() == "preset") {
         if (!it->second.IsScalar())
-          config::detail::throwAt(doc, it->second, section + ".preset", "expected a file path");
+          config::throwAt(doc, it->second, section + ".preset", "expected a file path");
         preset_path = it->second.Scalar();
       } else {
         overlay[it->first.Scalar()] = it->second;
       }
     }
   } else {
-    config::detail::throwAt(doc, node, section, "expected a file path or a map");
+    config::throwAt(doc, node, section, "expected a file path or a map");
   }
   config::Document out;
   out.overridden = overriddenBelow(doc, section);
@@ -126,10 +125,10 @@ Scenario loadScenarioDocument(config::Document doc, const std::string& base_dir,
   const YAML::Node rig_node = doc.root["rig"];
   const YAML::Node cam_node = rig_node.IsMap() ? rig_node["event_camera"] : YAML::Node();
   if (cam_node.IsDefined() && !cam_node.IsNull()) {
-    if (!cam_node.IsMap()) config::detail::throwAt(doc, cam_node, "rig.event_camera", "expected a map");
+    if (!cam_node.IsMap()) config::throwAt(doc, cam_node, "rig.event_camera", "expected a map");
     const YAML::Node preset = cam_node["preset"];
     if (preset.IsDefined() && !preset.IsNull() && !(preset.IsScalar() && preset.Scalar().empty())) {
-      if (!preset.IsScalar()) config::detail::throwAt(doc, preset, "rig.event_camera.preset", "expected a file path");
+      if (!preset.IsScalar()) config::throwAt(doc, preset, "rig.event_camera.preset", "expected a file path");
       const std::string path = resolvePath(preset.Scalar(), base_dir, search_root,
                                            config::where(doc, preset, "rig.event_camera.preset"));
       config::fill(config::loadFile(path), "", o.rig.event_camera.sensor);
@@ -223,9 +222,9 @@ std::string Scenario::resolvedYaml() const {
   out << YAML::Key << "description" << YAML::Value << o.description;
   out << YAML::Key << "seed" << YAML::Value << o.seed;
   out << YAML::Key << "start_s" << YAML::Value;
-  config::detail::emitDouble(out, o.start_s);
+  config::emitDouble(out, o.start_s);
   out << YAML::Key << "duration_s" << YAML::Value;
-  config::detail::emitDouble(out, o.duration_s);
+  config::emitDouble(out, o.duration_s);
   out << YAML::Key << "scene" << YAML::Value << YAML::Load(config::toYaml(scene.options));
   out << YAML::Key << "trajectory" << YAML::Value << YAML::Load(trajectory->configYaml());
   out << YAML::Key << "rig" << YAML::Value << YAML::Load(config::toYaml(o.rig));

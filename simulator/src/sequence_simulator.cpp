@@ -1,8 +1,6 @@
 #include "evio/simulator/sequence_simulator.h"
 
-#include <chrono>
 #include <cmath>
-#include <ctime>
 #include <filesystem>
 #include <sstream>
 
@@ -15,6 +13,7 @@
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/io/tracks_txt.h"
 #include "evio/core/io/tum.h"
+#include "evio/core/stopwatch.h"
 #include "evio/scenes/scene.h"
 #include "evio/simulator/imu_simulator.h"
 #include "evio/simulator/range_finder.h"
@@ -26,9 +25,6 @@ namespace evio::simulator {
 namespace fs = std::filesystem;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 std::string path(const std::string& folder, const std::string& name) { return (fs::path(folder) / name).string(); }
 
@@ -205,8 +201,8 @@ std::string SimulationStats::toYaml() const {
 
 SimulationStats simulateSequence(const Scenario& scenario, const std::string& folder,
                                  const ProgressCallback& progress) {
-  const auto t_start = Clock::now();
-  const std::clock_t cpu_start = std::clock();
+  const Stopwatch total;
+  const double cpu_start_s = Stopwatch::processCpuSeconds();
   SimulationStats stats;
   const auto& o = scenario.options;
   stats.simulated_s = nsToSeconds(scenario.end_ns - scenario.start_ns);
@@ -226,20 +222,20 @@ SimulationStats simulateSequence(const Scenario& scenario, const std::string& fo
   io::writeCalibTxt(path(folder, "calib.txt"), io::calibTxtFromCamera(event_camera));
   for (const char* f : {"scenario.yaml", "sensors.yaml", "calib.txt"}) stats.files.push_back(path(folder, f));
 
-  auto t0 = Clock::now();
+  Stopwatch watch;
   writeMotion(scenario, folder, &stats);
-  stats.truth_s += secondsSince(t0);
+  stats.truth_s += watch.seconds();
 
-  t0 = Clock::now();
+  watch.restart();
   scenes::SceneBuildOptions build;
   build.threads = o.threads;
   const scenes::Scene scene(scenario.scene, build);
-  stats.scene_build_s = secondsSince(t0);
+  stats.scene_build_s = watch.seconds();
 
   if (rig.range_finder) {
-    t0 = Clock::now();
+    watch.restart();
     writeRange(scenario, scene, rig, folder, &stats);
-    stats.truth_s += secondsSince(t0);
+    stats.truth_s += watch.seconds();
   }
 
   SequenceWriterOptions wo;
@@ -252,19 +248,19 @@ SimulationStats simulateSequence(const Scenario& scenario, const std::string& fo
   wo.depth = o.rig.frame_camera.enabled && o.output.depth_at_frames;
   SequenceWriter writer(folder, wo);
   const RenderLoopResult first = runRenderLoop(scenario, scene, writer, progress, &stats);
-  t0 = Clock::now();
+  watch.restart();
   for (auto& f : writer.close()) stats.files.push_back(f);
-  stats.write_s += secondsSince(t0);
+  stats.write_s += watch.seconds();
   stats.events = writer.eventCount();
   stats.frames = writer.frameCount();
   stats.depth_maps = writer.depthCount();
 
-  t0 = Clock::now();
+  watch.restart();
   writeTracks(scenario, scene, first, folder, &stats);
-  stats.truth_s += secondsSince(t0);
+  stats.truth_s += watch.seconds();
 
-  stats.wall_s = secondsSince(t_start);
-  stats.cpu_s = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  stats.wall_s = total.seconds();
+  stats.cpu_s = Stopwatch::processCpuSeconds() - cpu_start_s;
   const std::string stats_path = path(folder, "simulation_stats.yaml");
   io::writeFileAtomic(stats_path, stats.toYaml());
   stats.files.push_back(stats_path);

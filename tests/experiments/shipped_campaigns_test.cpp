@@ -47,7 +47,7 @@ void checkEstimatorSettings(const std::string& config_file, const Overrides& est
   if (m.empty()) {
     const YAML::Node node = doc.root["method"];
     if (!node.IsDefined()) throw Error("no method: neither the command nor the settings give one");
-    m = config::detail::scalarAs<std::string>(doc, node, "method");
+    m = config::scalarAs<std::string>(doc, node, "method");
   }
   config::applyOverride(doc, "method=" + m);
   estimator::PipelineOptions options = estimator::PipelineOptions::forMethod(m);

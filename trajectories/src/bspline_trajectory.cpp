@@ -34,12 +34,6 @@ std::array<taylor::Scalar<2>, 6> quinticBasis(const taylor::Scalar<2>& u) {
 
 namespace {
 
-Pose interpolate(const StampedPose& a, const StampedPose& b, TimeNs t_ns) {
-  const double w = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  return Pose(a.pose.quaternion().slerp(w, b.pose.quaternion()),
-              (1.0 - w) * a.pose.translation() + w * b.pose.translation());
-}
-
 TimeNs spanEnd(const std::vector<StampedPose>& samples, double duration_s) {
   require(samples.size() >= 2, "bspline trajectory: needs at least two poses");
   for (std::size_t i = 1; i < samples.size(); ++i)
@@ -69,7 +63,7 @@ BSplineTrajectory::BSplineTrajectory(const std::vector<StampedPose>& samples, do
   for (std::int64_t i = 0; i < n; ++i) {
     const TimeNs tau = std::min(t0 + i * step, t_last);
     while (k + 2 < samples.size() && samples[k + 1].t_ns <= tau) ++k;
-    control_.push_back(interpolate(samples[k], samples[k + 1], tau));
+    control_.push_back(interpolatePose(samples[k], samples[k + 1], tau));
   }
   delta_.assign(control_.size(), Vec3::Zero());
   for (std::size_t i = 1; i < control_.size(); ++i)

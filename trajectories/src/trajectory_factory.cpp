@@ -38,8 +38,8 @@ std::unique_ptr<ContinuousTrajectory> makeTrajectory(const config::Document& doc
   std::string known;
   for (const auto& t : trajectoryTypes()) known += (known.empty() ? "" : ", ") + t;
   if (!node.IsMap() || !node["type"].IsDefined() || node["type"].IsNull())
-    config::detail::throwAt(doc, node, type_path, "missing (one of: " + known + ")");
-  const std::string type = config::detail::scalarAs<std::string>(doc, node["type"], type_path);
+    config::throwAt(doc, node, type_path, "missing (one of: " + known + ")");
+  const std::string type = config::scalarAs<std::string>(doc, node["type"], type_path);
 
   if (type == "hover") return build<HoverOptions, HoverTrajectory>(doc, path);
   if (type == "rotation_only") return build<RotationOnlyOptions, RotationOnlyTrajectory>(doc, path);
@@ -59,7 +59,7 @@ std::unique_ptr<ContinuousTrajectory> makeTrajectory(const config::Document& doc
       throw Error(config::where(doc, node, path) + ": " + e.what());
     }
   }
-  config::detail::throwAt(doc, node["type"], type_path,
+  config::throwAt(doc, node["type"], type_path,
                           "unknown trajectory type '" + type + "' (one of: " + known + ")");
 }
 

@@ -93,14 +93,12 @@ YAML::Node child(const Document& doc, const std::string& path) {
   return node;
 }
 
-namespace detail {
-
 void throwAt(const Document& doc, const YAML::Node& node, const std::string& path,
              const std::string& message) {
   throw Error(where(doc, node, path) + ": " + path + ": " + message);
 }
 
-void Reader::rejectUnknownKeys() const {
+void detail::Reader::rejectUnknownKeys() const {
   for (auto it = node_.begin(); it != node_.end(); ++it) {
     if (!it->first.IsScalar()) throwAt(doc_, it->first, path_, "keys must be plain strings");
     const std::string& key = it->first.Scalar();
@@ -197,9 +195,7 @@ std::string scalarAs<std::string>(const Document& doc, const YAML::Node& node,
   return node.Scalar();
 }
 
-}  // namespace detail
-
-void detail::emitDouble(YAML::Emitter& out, double v) {
+void emitDouble(YAML::Emitter& out, double v) {
   if (std::isinf(v)) {
     out << (v > 0 ? ".inf" : "-.inf");
     return;

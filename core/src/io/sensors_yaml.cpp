@@ -18,8 +18,8 @@ namespace evio::io {
 namespace {
 
 using config::Document;
-using config::detail::scalarAs;
-using config::detail::throwAt;
+using config::scalarAs;
+using config::throwAt;
 
 constexpr double kOrthonormalTolerance = 1e-6;
 constexpr double kLastRowTolerance = 1e-12;

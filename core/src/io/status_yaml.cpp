@@ -15,8 +15,8 @@ namespace evio::io {
 namespace {
 
 using config::Document;
-using config::detail::scalarAs;
-using config::detail::throwAt;
+using config::scalarAs;
+using config::throwAt;
 
 TimeNs timeAt(const Document& doc, const YAML::Node& node, const std::string& key) {
   const double t_s = scalarAs<double>(doc, node, key);

@@ -53,6 +53,17 @@ struct StampedPose {
 
 using Trajectory = std::vector<StampedPose>;
 
+/// The pose at `t_ns` between two stamped poses (a.t_ns < b.t_ns; t_ns may lie
+/// outside, which extrapolates): with s = (t − t_a) / (t_b − t_a), the
+/// translation is (1 − s) p_a + s p_b and the rotation slerp(q_a, q_b, s).
+/// Both poses are T_W_X of the same frames; so is the result. No shortcut at
+/// the endpoints: s = 0 still goes through the slerp.
+Pose interpolatePose(const StampedPose& a, const StampedPose& b, TimeNs t_ns);
+
+/// The first pose of a time-sorted trajectory with t_ns >= `t_ns` (end() when
+/// none), by binary search.
+Trajectory::const_iterator firstPoseAtOrAfter(const Trajectory& trajectory, TimeNs t_ns);
+
 /// Angle in rad of the rotation between two quaternions.
 double angleBetween(const Quat& a, const Quat& b);
 

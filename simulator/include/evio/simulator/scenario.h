@@ -261,7 +261,4 @@ Scenario loadScenarioString(const std::string& text, const std::string& name, co
 /// the last row is 0 0 0 1.
 Pose rigidFromMatrix(const Mat4& T, const std::string& field);
 
-/// The evio version written into scenario.yaml.
-const char* evioVersion();
-
 }  // namespace evio::simulator

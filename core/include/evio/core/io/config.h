@@ -42,16 +42,16 @@ std::string where(const Document& doc, const YAML::Node& node, const std::string
 /// Returns the sub-document at dotted `path` (an empty map when absent).
 YAML::Node child(const Document& doc, const std::string& path);
 
-namespace detail {
+// Building blocks for modules that read or write YAML beyond Options structs.
 
-template <class T>
-struct IsStdVector : std::false_type {};
-template <class T, class A>
-struct IsStdVector<std::vector<T, A>> : std::true_type {};
-
+/// Throws Error "file:line: path: message" (or "--set path=…: path: message"
+/// for a value set on the command line) for `node` at dotted `path`.
 [[noreturn]] void throwAt(const Document& doc, const YAML::Node& node, const std::string& path,
                           const std::string& message);
 
+/// The scalar `node` as T (double, float, int, int64, uint64, bool, string);
+/// throws through throwAt when it is not a scalar of that type. Doubles accept
+/// .inf/-.inf and reject NaN.
 template <class T>
 T scalarAs(const Document& doc, const YAML::Node& node, const std::string& path);
 template <> double scalarAs<double>(const Document&, const YAML::Node&, const std::string&);
@@ -62,9 +62,41 @@ template <> std::uint64_t scalarAs<std::uint64_t>(const Document&, const YAML::N
 template <> bool scalarAs<bool>(const Document&, const YAML::Node&, const std::string&);
 template <> std::string scalarAs<std::string>(const Document&, const YAML::Node&, const std::string&);
 
-/// Reads a value of type T from a node (scalars, std::vector, fixed Eigen vectors).
+/// Reads a value of type T from a node at dotted `path` (for messages):
+/// scalars, std::vector, fixed-size Eigen matrices (row-major list) and
+/// Options structs (a map through fields(), unknown keys rejected, no
+/// validate()). Throws through throwAt.
 template <class T>
 void readValue(const Document& doc, const YAML::Node& node, const std::string& path, T& out);
+
+/// Writes a double with the shortest text that reads back to the same value
+/// (.inf/-.inf for infinities).
+void emitDouble(YAML::Emitter& out, double v);
+
+/// Writes fields() of an Options struct (or any value readValue reads) into
+/// an emitter: `Writer(out).write(options)` emits a map; doubles go through
+/// emitDouble, vectors and Eigen matrices as flow lists.
+class Writer {
+ public:
+  explicit Writer(YAML::Emitter& out) : out_(out) {}
+  template <class T>
+  void operator()(const char* key, const T& field, const char* /*doc*/ = "") {
+    out_ << YAML::Key << key << YAML::Value;
+    write(field);
+  }
+  template <class T>
+  void write(const T& field);
+
+ private:
+  YAML::Emitter& out_;
+};
+
+namespace detail {
+
+template <class T>
+struct IsStdVector : std::false_type {};
+template <class T, class A>
+struct IsStdVector<std::vector<T, A>> : std::true_type {};
 
 class Reader {
  public:
@@ -90,14 +122,22 @@ class Reader {
   std::set<std::string> seen_;
 };
 
+// Transitional: the old names of config::emitDouble and config::Writer, for
+// estimator/src/pipeline/pipeline_summary.cpp until it uses the public ones.
+// Remove with that switch.
+using config::emitDouble;
+using config::Writer;
+
+}  // namespace detail
+
 template <class T>
 void readValue(const Document& doc, const YAML::Node& node, const std::string& path, T& out) {
   if constexpr (IsVisitable<T>::value) {
     if (!node.IsMap()) throwAt(doc, node, path, "expected a map of options");
-    Reader reader(doc, node, path);
+    detail::Reader reader(doc, node, path);
     out.fields(reader);
     reader.rejectUnknownKeys();
-  } else if constexpr (IsStdVector<T>::value) {
+  } else if constexpr (detail::IsStdVector<T>::value) {
     if (!node.IsSequence()) throwAt(doc, node, path, "expected a list");
     out.clear();
     for (std::size_t i = 0; i < node.size(); ++i) {
@@ -120,30 +160,13 @@ void readValue(const Document& doc, const YAML::Node& node, const std::string& p
   }
 }
 
-class Writer {
- public:
-  explicit Writer(YAML::Emitter& out) : out_(out) {}
-  template <class T>
-  void operator()(const char* key, const T& field, const char* /*doc*/ = "") {
-    out_ << YAML::Key << key << YAML::Value;
-    write(field);
-  }
-  template <class T>
-  void write(const T& field);
-
- private:
-  YAML::Emitter& out_;
-};
-
-void emitDouble(YAML::Emitter& out, double v);
-
 template <class T>
 void Writer::write(const T& field) {
   if constexpr (IsVisitable<T>::value) {
     out_ << YAML::BeginMap;
     const_cast<T&>(field).fields(*this);
     out_ << YAML::EndMap;
-  } else if constexpr (IsStdVector<T>::value) {
+  } else if constexpr (detail::IsStdVector<T>::value) {
     out_ << YAML::Flow << YAML::BeginSeq;
     for (const auto& item : field) write(item);
     out_ << YAML::EndSeq;
@@ -159,15 +182,13 @@ void Writer::write(const T& field) {
   }
 }
 
-}  // namespace detail
-
 /// Fills `options` from the map at dotted `path` of `doc` (the root when
 /// empty), then calls validate(); validation errors name the file.
 template <class Options>
 void fill(const Document& doc, const std::string& path, Options& options) {
   const YAML::Node node = path.empty() ? doc.root : child(doc, path);
   try {
-    if (node.IsDefined() && !node.IsNull()) detail::readValue(doc, node, path, options);
+    if (node.IsDefined() && !node.IsNull()) readValue(doc, node, path, options);
   } catch (const YAML::Exception& e) {  // anything yaml-cpp itself rejects
     throw Error::inFile(doc.file, e.mark.line + 1, "invalid YAML: " + e.msg);
   }
@@ -192,7 +213,7 @@ Options load(const std::string& file, const std::vector<std::string>& overrides 
 template <class Options>
 std::string toYaml(const Options& options) {
   YAML::Emitter out;
-  detail::Writer writer(out);
+  Writer writer(out);
   writer.write(options);
   return std::string(out.c_str()) + "\n";
 }

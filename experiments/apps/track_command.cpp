@@ -2,7 +2,6 @@
 //  [--config file] [--set key=value] -o tracks.txt`: runs a feature-tracking
 // frontend over a sequence folder and writes its tracks (id t x y), with the
 // resolved configuration beside them (<output>.yaml).
-#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>

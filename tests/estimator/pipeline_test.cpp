@@ -6,8 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include "evio/core/io/atomic_file.h"
@@ -317,10 +315,7 @@ TEST(Pipeline, GroundTruthIsReadOnlyWhenAskedFor) {
   const PipelineResult r_gt = runPipeline(seq, tracksOptions(), dir.file("gt"));
   EXPECT_EQ(r_gt.status.code, io::EstimateStatus::Code::kOk);
   EXPECT_TRUE(r_gt.initialization_t_ns.has_value());
-  const auto read = [](const std::string& path) {
-    std::ifstream in(path);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
+  const auto read = [](const std::string& path) { return io::readFile(path); };
   EXPECT_NE(read(dir.file("static/config.yaml")).find("mode: static"), std::string::npos);
   EXPECT_NE(read(dir.file("gt/config.yaml")).find("mode: groundtruth"), std::string::npos);
   EXPECT_NE(read(dir.file("gt/summary.yaml")).find("initialization: groundtruth"), std::string::npos);

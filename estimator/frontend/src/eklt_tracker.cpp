@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cmath>
 
 #include <opencv2/video/tracking.hpp>
 
 #include "evio/core/error.h"
+#include "evio/core/stopwatch.h"
 #include "evio/estimator/frontend/feature_detection.h"
 #include "evio/estimator/frontend/log_image.h"
 
@@ -15,11 +15,6 @@ namespace evio::estimator {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
@@ -235,7 +230,7 @@ void EkltTracker::splat(Slot& s, double x, double y, bool positive, TimeNs t_ns)
 }
 
 void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::size_t end) {
-  const auto start = Clock::now();
+  const Stopwatch start;
   const auto& t = events.t();
   const auto& x = events.x();
   const auto& y = events.y();
@@ -261,18 +256,18 @@ void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::si
   }
   timing_.events += end - begin;
   timing_.events_in_patches += splats;
-  timing_.events_s += secondsSince(start);
+  timing_.events_s += start.seconds();
 }
 
 void EkltTracker::optimise(int index) {
-  const auto start = Clock::now();
+  const Stopwatch start;
   Slot& s = slots_[static_cast<std::size_t>(index)];
   const TimeNs t_mid = s.t_first_ns + (s.t_last_ns - s.t_first_ns) / 2;
   double norm2 = 0.0;
   for (float v : s.patch) norm2 += static_cast<double>(v) * static_cast<double>(v);
   if (!(norm2 > 0.0)) {  // the events cancelled out: nothing to align
     resetPatch(s);
-    timing_.optimisation_s += secondsSince(start);
+    timing_.optimisation_s += start.seconds();
     return;
   }
   const float inv = static_cast<float>(1.0 / std::sqrt(norm2));
@@ -298,7 +293,7 @@ void EkltTracker::optimise(int index) {
       !camera_.isInside(uv, options_.lost_border_px)) {
     if (sol.valid) s.quality = sol.quality();
     lose(index);
-    timing_.optimisation_s += secondsSince(start);
+    timing_.optimisation_s += start.seconds();
     return;
   }
   s.theta = sol.p[0];
@@ -314,11 +309,11 @@ void EkltTracker::optimise(int index) {
     grid_.move(index, s.rect, rect);
     s.rect = rect;
   }
-  timing_.optimisation_s += secondsSince(start);
+  timing_.optimisation_s += start.seconds();
 }
 
 void EkltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
-  const auto start = Clock::now();
+  const Stopwatch start;
   require(image.cols == width_ && image.rows == height_, "EkltTracker: frame size differs from the camera's");
   const cv::Mat log_image = toLogImage(image, options_.log_offset);
   const cv::Mat image8 = toEightBit(image);
@@ -326,7 +321,7 @@ void EkltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
   imageGradient(log_image, &gx, &gy);
 
   // 1. Bootstrap the features detected on the previous frame.
-  const auto t_boot = Clock::now();
+  const Stopwatch t_boot;
   std::vector<int> pending;
   std::vector<cv::Point2f> p0, p1;
   for (std::size_t i = 0; i < slots_.size(); ++i)
@@ -358,10 +353,10 @@ void EkltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
       out_.push_back(TrackPoint{s.id, t_ns, uv, 1.0, TrackStatus::kTracked});
     }
   }
-  timing_.bootstrap_s += secondsSince(t_boot);
+  timing_.bootstrap_s += t_boot.seconds();
 
   // 2. Re-detect when too few features are alive.
-  const auto t_detect = Clock::now();
+  const Stopwatch t_detect;
   const std::size_t alive = numAlive();
   if (alive < static_cast<std::size_t>(options_.min_features)) {
     std::vector<Vec2> existing;
@@ -384,10 +379,10 @@ void EkltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
       assignTemplate(s, gx, gy, corner);
     }
   }
-  timing_.detection_s += secondsSince(t_detect);
+  timing_.detection_s += t_detect.seconds();
   previous_frame8_ = image8.clone();
   previous_frame_t_ns_ = t_ns;
-  timing_.frame_s += secondsSince(start);
+  timing_.frame_s += start.seconds();
 }
 
 }  // namespace evio::estimator

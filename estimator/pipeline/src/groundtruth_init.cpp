@@ -27,15 +27,12 @@ Pose interpolatePose(const Trajectory& T_W_C, TimeNs t_ns) {
   if (t_ns < T_W_C.front().t_ns || t_ns > T_W_C.back().t_ns)
     throw Error("ground truth: time " + secondsText(t_ns) + " outside its span [" + secondsText(T_W_C.front().t_ns) +
                 ", " + secondsText(T_W_C.back().t_ns) + "]");
-  const auto it = std::lower_bound(T_W_C.begin(), T_W_C.end(), t_ns,
-                                   [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
+  const auto it = firstPoseAtOrAfter(T_W_C, t_ns);
   if (it->t_ns == t_ns) return it->pose;
-  const StampedPose& b = *it;
-  const StampedPose& a = *(it - 1);
-  const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  const Vec3 p = (1.0 - s) * a.pose.translation() + s * b.pose.translation();
-  const Quat q = a.pose.quaternion().slerp(s, b.pose.quaternion());
-  return Pose(q.normalized(), p);
+  // Position linear, rotation by slerp (core/pose.h); the initial attitude is
+  // normalised once more, as the estimator always did.
+  const Pose T = evio::interpolatePose(*(it - 1), *it, t_ns);
+  return Pose(T.quaternion().normalized(), T.translation());
 }
 
 ImuState initialStateFromTrajectory(const Trajectory& T_W_C, TimeNs t_cam_ns, const Pose& T_B_C,

@@ -1,12 +1,11 @@
 #include "evio/estimator/pipeline/pipeline.h"
 
-#include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <memory>
 
 #include "evio/core/error.h"
+#include "evio/core/stopwatch.h"
 #include "evio/core/io/config.h"
 #include "evio/core/io/images_txt.h"
 #include "evio/estimator/pipeline/estimate_writer.h"
@@ -19,7 +18,6 @@ namespace evio::estimator {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 std::string secondsText(TimeNs t_ns) {
   char buf[32];
@@ -30,14 +28,14 @@ std::string secondsText(TimeNs t_ns) {
 /// Adds the wall time of its lifetime to a counter.
 class StageTimer {
  public:
-  explicit StageTimer(double* acc) : acc_(acc), start_(Clock::now()) {}
-  ~StageTimer() { *acc_ += std::chrono::duration<double>(Clock::now() - start_).count(); }
+  explicit StageTimer(double* acc) : acc_(acc) {}
+  ~StageTimer() { *acc_ += watch_.seconds(); }
   StageTimer(const StageTimer&) = delete;
   StageTimer& operator=(const StageTimer&) = delete;
 
  private:
   double* acc_;
-  Clock::time_point start_;
+  Stopwatch watch_;
 };
 
 /// One run of the pipeline; see pipeline.h. setup() builds the stages once;
@@ -50,8 +48,8 @@ class PipelineRun {
       : sequence_(sequence), options_(options), output_(output), progress_(progress) {}
 
   PipelineResult run() {
-    run_start_ = Clock::now();
-    run_start_cpu_ = std::clock();
+    run_watch_.restart();
+    run_start_cpu_s_ = Stopwatch::processCpuSeconds();
     setup();
     loop();
     finish();
@@ -70,8 +68,7 @@ class PipelineRun {
   io::EstimateStatus finalStatus() const;
   /// Processing time since the loop started on the clock of output.timing_clock.
   double elapsed() const {
-    if (cpu_clock_) return static_cast<double>(std::clock() - loop_start_cpu_) / CLOCKS_PER_SEC;
-    return std::chrono::duration<double>(Clock::now() - loop_start_).count();
+    return cpu_clock_ ? Stopwatch::processCpuSeconds() - loop_start_cpu_s_ : loop_watch_.seconds();
   }
 
   const std::string& sequence_;
@@ -103,10 +100,10 @@ class PipelineRun {
   std::vector<Estimate> estimates_;
 
   // Loop state
-  Clock::time_point run_start_;
-  std::clock_t run_start_cpu_ = 0;
-  Clock::time_point loop_start_;
-  std::clock_t loop_start_cpu_ = 0;
+  Stopwatch run_watch_;
+  double run_start_cpu_s_ = 0.0;
+  Stopwatch loop_watch_;
+  double loop_start_cpu_s_ = 0.0;
   bool cpu_clock_ = false;
   bool have_imu_ = false;
   TimeNs last_imu_cam_ = 0;
@@ -266,8 +263,8 @@ void PipelineRun::writeTiming(TimeNs t_ns) {
 }
 
 void PipelineRun::loop() {
-  loop_start_ = Clock::now();
-  loop_start_cpu_ = std::clock();
+  loop_watch_.restart();
+  loop_start_cpu_s_ = Stopwatch::processCpuSeconds();
   cpu_clock_ = options_.output.timing_clock == "cpu";
   SequenceItem item;
   while (true) {
@@ -330,12 +327,12 @@ void PipelineRun::finish() {
   result_.status = finalStatus();
   {
     StageTimer timer(&result_.times.output_s);
-    result_.times.total_s = std::chrono::duration<double>(Clock::now() - run_start_).count();
-    result_.times.cpu_s = static_cast<double>(std::clock() - run_start_cpu_) / CLOCKS_PER_SEC;
+    result_.times.total_s = run_watch_.seconds();
+    result_.times.cpu_s = Stopwatch::processCpuSeconds() - run_start_cpu_s_;
     writer_->finish(result_.status, config::toYaml(options_), formatPipelineSummary(result_, options_));
   }
-  result_.times.total_s = std::chrono::duration<double>(Clock::now() - run_start_).count();
-  result_.times.cpu_s = static_cast<double>(std::clock() - run_start_cpu_) / CLOCKS_PER_SEC;
+  result_.times.total_s = run_watch_.seconds();
+  result_.times.cpu_s = Stopwatch::processCpuSeconds() - run_start_cpu_s_;
 }
 
 }  // namespace

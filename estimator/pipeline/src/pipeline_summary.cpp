@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "evio/core/io/config.h"
+#include "evio/core/version.h"
 #include "evio/estimator/pipeline/pipeline.h"
 
 namespace evio::estimator {
@@ -11,7 +12,7 @@ namespace {
 
 void emitSeconds(YAML::Emitter& out, const char* key, double v) {
   out << YAML::Key << key << YAML::Value;
-  config::detail::emitDouble(out, v);
+  config::emitDouble(out, v);
 }
 
 }  // namespace
@@ -19,6 +20,7 @@ void emitSeconds(YAML::Emitter& out, const char* key, double v) {
 std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions& options) {
   YAML::Emitter out;
   out << YAML::BeginMap;
+  out << YAML::Key << "version" << YAML::Value << evioVersion();
   out << YAML::Key << "method" << YAML::Value << options.method;
   out << YAML::Key << "initialization" << YAML::Value << options.init.mode;
   out << YAML::Key << "status" << YAML::Value << std::string(io::estimateStatusName(r.status.code));
@@ -30,7 +32,7 @@ std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions
   if (r.initialization_t_ns) emitSeconds(out, "initialization_s", nsToSeconds(*r.initialization_t_ns));
   const double data_s = nsToSeconds(r.t_last_ns - r.initialization_t_ns.value_or(r.t_first_ns));
   emitSeconds(out, "data_after_initialization_s", data_s);
-  config::detail::Writer writer(out);
+  config::Writer writer(out);
   out << YAML::Key << "counts" << YAML::Value;
   writer.write(r.counts);
   out << YAML::Key << "stage_times_s" << YAML::Value;

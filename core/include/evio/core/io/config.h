@@ -122,12 +122,6 @@ class Reader {
   std::set<std::string> seen_;
 };
 
-// Transitional: the old names of config::emitDouble and config::Writer, for
-// estimator/src/pipeline/pipeline_summary.cpp until it uses the public ones.
-// Remove with that switch.
-using config::emitDouble;
-using config::Writer;
-
 }  // namespace detail
 
 template <class T>

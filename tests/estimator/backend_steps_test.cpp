@@ -3,7 +3,9 @@
 // msckf_updater.h), each on its own, against exact answers.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <unordered_set>
+#include <utility>
 
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/aux_updaters.h"
@@ -41,6 +43,17 @@ FilterState restingState(int clones, double p_var = 1e-2) {
   s.P = p_var * MatX::Identity(s.dim(), s.dim());
   return s;
 }
+
+/// What an updater works on, owned by the test.
+struct UpdaterBench {
+  explicit UpdaterBench(FilterState s) : state(std::move(s)), fej(state.imu) {}
+  UpdaterContext context() { return UpdaterContext{&state, &fej, &options, &stats}; }
+  FilterState state;
+  ImuState fej;
+  BackendOptions options;
+  BackendStats stats;
+  Chi2Table chi2{0.95};
+};
 
 TEST(BackendSteps, UndistortObservationsGivesNormalisedCoordinatesOncePerFeature) {
   MeasurementSet set;
@@ -104,61 +117,53 @@ TEST(BackendUpdaters, ConstrainRemovesTheYawDirectionExactlyOnce) {
   state.imu.p_W_B = Vec3(1, 2, 3);
   state.imu.v_W = Vec3(0.5, -0.2, 0.1);
   state.clones[1].p_fej = Vec3(0.3, 0.1, 0.0);
-  BackendOptions options;
-  options.observability_constraint = true;
-  BackendStats stats;
-  const ImuState fej = state.imu;
-  ZeroVelocityUpdater updater(UpdaterContext{&state, &fej, &options, &stats});
-  MatX H = MatX::Ones(3, state.dim());
+  UpdaterBench b(state);
+  b.options.observability_constraint = true;
+  ZeroVelocityUpdater updater(b.context());
+  MatX H = MatX::Ones(3, b.state.dim());
   updater.constrain(&H);
-  const VecX n = state.yawDirection(fej);
+  const VecX n = b.state.yawDirection(b.fej);
   EXPECT_LT((H * n).norm(), 1e-12 * n.norm());
-  options.observability_constraint = false;
-  MatX H2 = MatX::Ones(3, state.dim());
+  b.options.observability_constraint = false;
+  MatX H2 = MatX::Ones(3, b.state.dim());
   updater.constrain(&H2);
-  EXPECT_TRUE(H2.isApprox(MatX::Ones(3, state.dim())));
+  EXPECT_TRUE(H2.isApprox(MatX::Ones(3, b.state.dim())));
 }
 
 TEST(BackendUpdaters, ZeroVelocityUpdateIsTheScalarKalmanGainPerAxis) {
   // P_vv = p I, σ = s: v⁺ = v̂ s²/(p + s²), P_vv⁺ = p s²/(p + s²) (no cross terms).
   FilterState state = restingState(0, 0.04);
   state.imu.v_W = Vec3(1.0, -2.0, 0.5);
-  BackendOptions options;
-  options.observability_constraint = false;
-  options.zero_velocity_sigma_mps = 0.1;
-  BackendStats stats;
-  const ImuState fej = state.imu;
-  ZeroVelocityUpdater updater(UpdaterContext{&state, &fej, &options, &stats});
+  UpdaterBench b(state);
+  b.options.observability_constraint = false;
+  b.options.zero_velocity_sigma_mps = 0.1;
+  ZeroVelocityUpdater updater(b.context());
   ASSERT_TRUE(updater.update());
   const double k = 0.01 / (0.04 + 0.01);
-  EXPECT_TRUE(state.imu.v_W.isApprox(Vec3(1.0, -2.0, 0.5) * k, 1e-12));
-  EXPECT_NEAR(state.P(kIdxV, kIdxV), 0.04 * k, 1e-15);
-  EXPECT_NEAR(state.P(kIdxP, kIdxP), 0.04, 1e-15);  // uncorrelated: untouched
-  EXPECT_EQ(stats.zero_velocity_updates, 1);
+  EXPECT_TRUE(b.state.imu.v_W.isApprox(Vec3(1.0, -2.0, 0.5) * k, 1e-12));
+  EXPECT_NEAR(b.state.P(kIdxV, kIdxV), 0.04 * k, 1e-15);
+  EXPECT_NEAR(b.state.P(kIdxP, kIdxP), 0.04, 1e-15);  // uncorrelated: untouched
+  EXPECT_EQ(b.stats.zero_velocity_updates, 1);
 }
 
 TEST(BackendUpdaters, RangeOutsideTheSensorsSpanIsRejectedAndKeepsTheState) {
-  FilterState state = restingState(0);
-  BackendOptions options;
-  BackendStats stats;
-  const ImuState fej = state.imu;
+  UpdaterBench b(restingState(0));
   RangeFinderSensor sensor;
   sensor.min_range_m = 0.5;
   sensor.max_range_m = 10.0;
-  const Chi2Table chi2(0.95);
-  RangeUpdater updater(UpdaterContext{&state, &fej, &options, &stats}, sensor, &chi2);
-  const MatX P = state.P;
+  RangeUpdater updater(b.context(), sensor, &b.chi2);
+  const MatX P = b.state.P;
   EXPECT_TRUE(updater.update(20.0));
   EXPECT_TRUE(updater.update(0.1));
-  EXPECT_EQ(stats.range_rejected, 2);
+  EXPECT_EQ(b.stats.range_rejected, 2);
   EXPECT_FALSE(updater.latestHit().has_value());
   // In range but no SLAM features to form a plane: rejected, the hit point kept
   // for depth priors (origin + 4 m along the beam, +z of B here).
   EXPECT_TRUE(updater.update(4.0));
-  EXPECT_EQ(stats.range_rejected, 3);
+  EXPECT_EQ(b.stats.range_rejected, 3);
   ASSERT_TRUE(updater.latestHit().has_value());
   EXPECT_TRUE(updater.latestHit()->second.isApprox(Vec3(0, 0, 4)));
-  EXPECT_TRUE(state.P.isApprox(P));
+  EXPECT_TRUE(b.state.P.isApprox(P));
 }
 
 TEST(BackendUpdaters, SlamPruneDropsGatedOutAndNonFiniteFeatures) {
@@ -171,32 +176,25 @@ TEST(BackendUpdaters, SlamPruneDropsGatedOutAndNonFiniteFeatures) {
   }
   state.features[3].abr.z() = std::numeric_limits<double>::quiet_NaN();
   state.P = MatX::Identity(state.dim(), state.dim());
-  BackendOptions options;
-  BackendStats stats;
-  const ImuState fej = state.imu;
-  const Chi2Table chi2(0.95);
-  SlamUpdater slam(UpdaterContext{&state, &fej, &options, &stats}, kCamera, 0.01, &chi2, &chi2, nullptr);
+  UpdaterBench b(state);
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
   slam.prune({2, 0});
-  ASSERT_EQ(state.features.size(), 1u);
-  EXPECT_EQ(state.features[0].id, 1);
-  EXPECT_EQ(state.dim(), kImuDim + kCloneDim + kFeatureDim);
-  EXPECT_EQ(stats.slam_features_removed, 3);
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_EQ(b.state.features[0].id, 1);
+  EXPECT_EQ(b.state.dim(), kImuDim + kCloneDim + kFeatureDim);
+  EXPECT_EQ(b.stats.slam_features_removed, 3);
 }
 
 TEST(BackendUpdaters, MsckfUsesEveryChosenTrackOnceAndCountsWhyNot) {
   // Two clones with no baseline: no parallax for any track; each chosen track is emptied.
-  FilterState state = restingState(2);
-  BackendOptions options;
-  BackendStats stats;
-  const ImuState fej = state.imu;
-  const Chi2Table chi2(0.95);
-  MsckfUpdater msckf(UpdaterContext{&state, &fej, &options, &stats}, kCamera, 1e-4, &chi2);
+  UpdaterBench b(restingState(2));
+  MsckfUpdater msckf(b.context(), kCamera, 1e-4, &b.chi2);
   TrackMap tracks = tracksOf({track(1, {0, 1}), track(2, {0, 1})});
   const UpdateRows rows = msckf.residuals({1, 2}, &tracks);
   EXPECT_EQ(rows.H.rows(), 0);
-  EXPECT_EQ(rows.H.cols(), state.dim());
+  EXPECT_EQ(rows.H.cols(), b.state.dim());
   EXPECT_EQ(msckf.lastCount(), 0);
-  EXPECT_EQ(stats.msckf_features_no_parallax + stats.msckf_triangulation_failed, 2);
+  EXPECT_EQ(b.stats.msckf_features_no_parallax + b.stats.msckf_triangulation_failed, 2);
   EXPECT_TRUE(tracks[1].observations.empty());
   EXPECT_TRUE(tracks[2].observations.empty());
 }

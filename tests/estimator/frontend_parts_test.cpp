@@ -165,7 +165,7 @@ TEST(FrontendOptions, DefaultsRoundTripThroughYamlAndOverridesAreChecked) {
   FrontendOptions back;
   config::fill(config::loadString(config::toYaml(defaults), "defaults.yaml"), "", back);
   EXPECT_TRUE(config::equal(defaults, back));
-  // The reference values (ALGORITHMS.md) are the defaults.
+  // The reference values (docs/algorithms.md#eklt) are the defaults.
   EXPECT_EQ(defaults.eklt.patch_size_px, 19);
   EXPECT_EQ(defaults.eklt.max_features, 60);
   EXPECT_EQ(defaults.eklt.min_features, 45);

@@ -254,11 +254,12 @@ steps:
   const std::string seq = jobs[0].sequence_key;
   EXPECT_EQ(estimate_command["klt-vio"],
             "/bin/true estimate " + (fs::path(o.results) / "sequences" / seq).string() + " --config " +
-                c.estimator_config + " --method klt-vio -o estimate -q --set seed=1");
+                c.estimator_config + " --method klt-vio --init groundtruth -o estimate -q --set seed=1");
   EXPECT_EQ(estimate_command["fewer_features"],
             "/bin/true estimate " + (fs::path(o.results) / "sequences" / seq).string() + " --config " +
                 c.estimator_config +
-                " -o estimate -q --set seed=1 --set method=eklt-vio --set frontend.eklt.max_features=20");
+                " --init groundtruth -o estimate -q --set seed=1 --set method=eklt-vio "
+                "--set frontend.eklt.max_features=20");
   // A missing configuration is an error at load time, naming the key.
   io::writeFileAtomic(dir.file("bad.yaml"), "name: x\nseeds: [1]\nscenarios: [{name: a, file: a.yaml}]\n"
                                             "methods: [klt-vio]\nestimator_config: nowhere.yaml\n");

@@ -1,6 +1,6 @@
 #pragma once
 /// @file tiny_sequence.h
-/// Writes a small sequence folder (DESIGN.md layout) for pipeline tests with
+/// Writes a small sequence folder (docs/architecture.md#the-sequence-folder) for pipeline tests with
 /// the core/io writers: the first seconds of the six_dof trajectory preset,
 /// IMU from ImuSimulator (Kalibr noise model, DAVIS240 reference densities),
 /// groundtruth.txt (T_W_C of the camera), exact ground-truth tracks of a

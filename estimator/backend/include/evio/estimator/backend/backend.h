@@ -1,7 +1,7 @@
 #pragma once
 /// @file backend.h
-/// The xVIO-style EKF backend of EKLT-VIO and KLT-VIO (eklt-vio-paper.tex,
-/// Backend; ALGORITHMS.md, xVIO backend). State and error-state convention:
+/// The xVIO-style EKF backend of EKLT-VIO and KLT-VIO (Mahlknecht et al. 2022,
+/// Backend; docs/algorithms.md#ekf-backend). State and error-state convention:
 /// filter_state.h; propagation: imu_propagation.h; updates: msckf_update.h,
 /// slam_features.h, range_update.h, ekf_update.h.
 ///

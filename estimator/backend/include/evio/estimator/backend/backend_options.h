@@ -1,7 +1,7 @@
 #pragma once
 /// @file backend_options.h
 /// Parameters of the xVIO-style EKF backend with the reference defaults of
-/// ALGORITHMS.md (xVIO backend; DAVIS240 IMU noise) and the paper (M = 10,
+/// docs/algorithms.md#ekf-backend (DAVIS240 IMU noise) and the paper (M = 10,
 /// N = 15), and the sensors the backend needs (from sensors.yaml).
 
 #include <optional>
@@ -41,7 +41,7 @@ struct BackendOptions {
   /// A gap longer than this sets the status to failed, s.
   double imu_fail_gap_s = 1.0;
 
-  // Initial uncertainty (ALGORITHMS.md) ------------------------------------------
+  // Initial uncertainty (docs/algorithms.md#divergence-and-failure) ------------------------------
   double initial_sigma_p_m = 0.0;          ///< position (0: exactly known; stored as 1e-12 m²)
   double initial_sigma_v_mps = 0.05;       ///< velocity, m/s
   double initial_sigma_theta_deg = 3.0;    ///< attitude, deg (all three axes)

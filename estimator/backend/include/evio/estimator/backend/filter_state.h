@@ -1,7 +1,7 @@
 #pragma once
 /// @file filter_state.h
-/// The EKF state of the xVIO-style backend (eklt-vio-paper.tex, Backend;
-/// ALGORITHMS.md, xVIO backend): the IMU state, a sliding window of camera
+/// The EKF state of the xVIO-style backend (Mahlknecht et al. 2022, Backend;
+/// docs/algorithms.md#error-state): the IMU state, a sliding window of camera
 /// pose clones and SLAM features in anchored inverse depth, with the error-state
 /// covariance P.
 ///

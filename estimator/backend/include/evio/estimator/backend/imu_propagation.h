@@ -1,6 +1,6 @@
 #pragma once
 /// @file imu_propagation.h
-/// IMU propagation of the backend (ALGORITHMS.md, xVIO backend: higher-order
+/// IMU propagation of the backend (docs/algorithms.md#imu-propagation: higher-order
 /// quaternion integration on the mean rate, trapezoidal velocity/position,
 /// closed-form discrete transition and noise). Error-state convention:
 /// filter_state.h (R = R̂ Exp(δθ), δθ in B).

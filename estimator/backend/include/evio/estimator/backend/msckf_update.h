@@ -1,7 +1,7 @@
 #pragma once
 /// @file msckf_update.h
 /// The MSCKF measurement of one feature track (Mourikis & Roumeliotis 2007;
-/// ALGORITHMS.md, MSCKF features): triangulate the point p_W from the track's
+/// docs/algorithms.md#msckf-features): triangulate the point p_W from the track's
 /// observations in the window (triangulation.h), linearise all observations,
 ///   r = z − π(R_iᵀ (p̂_W − p_i)) ≈ H_x δx + H_f δp_W + n,
 /// and project on the left null space of H_f (ekf_update.h) so that the

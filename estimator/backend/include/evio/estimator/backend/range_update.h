@@ -1,6 +1,6 @@
 #pragma once
 /// @file range_update.h
-/// Laser range-finder update (ALGORITHMS.md, Mars-helicopter extension; the
+/// Laser range-finder update (docs/algorithms.md#range-and-zero-velocity-updates, Mars-helicopter extension; the
 /// xVIO range update): the beam from the range finder's origin o along its +z
 /// axis d meets the terrain plane through three SLAM features q1, q2, q3
 /// (those whose rays are nearest to the beam), and the predicted range is

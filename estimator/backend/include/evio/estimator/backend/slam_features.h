@@ -1,7 +1,7 @@
 #pragma once
 /// @file slam_features.h
-/// SLAM features in anchored inverse depth (eklt-vio-paper.tex, Backend;
-/// ALGORITHMS.md, SLAM features): their measurement, their two ways into the
+/// SLAM features in anchored inverse depth (Mahlknecht et al. 2022, Backend;
+/// docs/algorithms.md#slam-features): their measurement, their two ways into the
 /// state, and re-anchoring when the window slides.
 
 #include <cstddef>

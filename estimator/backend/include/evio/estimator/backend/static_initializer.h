@@ -1,6 +1,6 @@
 #pragma once
 /// @file static_initializer.h
-/// Static initialisation from a still IMU (ALGORITHMS.md notes xVIO lacks it):
+/// Static initialisation from a still IMU (docs/algorithms.md#static-initialisation; xVIO has none):
 /// over a window of readings with small spread, the mean specific force ā is
 /// −g_W seen in B, so R_W_B ā/‖ā‖ = e_z fixes roll and pitch (yaw is set to
 /// `yaw_rad`, it is unobservable), and the mean rate is the gyroscope bias.

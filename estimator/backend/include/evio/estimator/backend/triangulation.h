@@ -1,7 +1,7 @@
 #pragma once
 /// @file triangulation.h
 /// Triangulation of a feature from its observations in the sliding window
-/// (ALGORITHMS.md: Gauss–Newton in inverse depth, 10 iterations, tol 1e-5).
+/// (docs/algorithms.md#triangulation: Gauss–Newton in inverse depth, 10 iterations, tol 1e-5).
 ///
 /// 1. Linear start: the point p minimising Σ_i ‖(I − b_i b_iᵀ)(p − p_i)‖²,
 ///    b_i = R_i [z_i; 1]/‖·‖ the unit rays, p_i the clone positions.
@@ -39,7 +39,7 @@ struct TriangulationResult {
 bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
                         std::size_t anchor, const TriangulationOptions& options, TriangulationResult* result);
 
-/// Rotation-compensated disparity of a track (ALGORITHMS.md parallax test):
+/// Rotation-compensated disparity of a track (docs/algorithms.md#triangulation, the parallax test):
 /// the largest distance, in normalised units, between the observation in the
 /// last clone and the rays of the other observations rotated into it,
 ///   max_i ‖π(R_lastᵀ R_i [z_i; 1]) − z_last‖.

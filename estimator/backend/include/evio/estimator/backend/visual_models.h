@@ -5,7 +5,7 @@
 /// R_W_C = R̂ Exp(δθ_C); feature error [δα δβ δρ]).
 ///
 /// Measurements are normalised image coordinates z = π(h) = (h_x/h_z, h_y/h_z)
-/// of the undistorted observation (eklt-vio-paper.tex, Eq. feature-measurement).
+/// of the undistorted observation (Mahlknecht et al. 2022, the feature measurement; docs/algorithms.md#visual-measurement-models).
 ///
 ///  - World point in clone i (MSCKF):      h = R_iᵀ (p_W − p_i)
 ///  - Anchored inverse depth (SLAM), anchor a, b = [α, β, 1]ᵀ:

@@ -1,7 +1,7 @@
 #pragma once
 /// @file eklt_cost.h
 /// The EKLT alignment cost for one batch of events (Gehrig et al., IJCV 2019;
-/// eklt-vio-paper.tex, Eq. eklt-optimization).
+/// Mahlknecht et al. 2022, the EKLT optimisation; docs/algorithms.md#eklt).
 ///
 /// Parameters p = (θ, tx, ty, φ): a rigid warp W(u; θ, t) = R(θ) u + t that
 /// maps a patch offset u (px, relative to the point around which the batch

@@ -1,7 +1,7 @@
 #pragma once
 /// @file eklt_options.h
 /// Parameters of the EKLT tracker with the reference defaults
-/// (shared/reference/ALGORITHMS.md, EKLT tracker; 6-DOF sequences).
+/// (docs/algorithms.md#eklt; 6-DOF sequences).
 
 #include <string>
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file eklt_tracker.h
-/// EKLT (Gehrig et al., IJCV 2019) as used by EKLT-VIO (eklt-vio-paper.tex,
+/// EKLT (Gehrig et al., IJCV 2019) as used by EKLT-VIO (Mahlknecht et al. 2022,
 /// Frontend): Harris corners detected on frames; per feature a template of
 /// the log-image gradient; events splatted bilinearly into a P×P patch
 /// around the feature; when the patch holds an adaptive number of events the

@@ -1,7 +1,7 @@
 #pragma once
 /// @file event_prefilter.h
 /// Event-rate reduction before tracking, the speed-up strategies of
-/// eklt-vio-paper.tex (Speedup Strategies): random filtering (RF), which keeps
+/// Mahlknecht et al. 2022 (Speedup Strategies; docs/algorithms.md#event-pre-filters): random filtering (RF), which keeps
 /// on average every r-th event, and refractory-period filtering (RPF), which
 /// drops an event that follows the previous *kept* event of the same pixel by
 /// less than τ.

@@ -1,7 +1,7 @@
 #pragma once
 /// @file gyro_predictor.h
 /// IMU-based prediction of feature positions between EKLT batches
-/// (eklt-vio-paper.tex, Speedup Strategies, after Bloesch et al. 2015): the
+/// (Mahlknecht et al. 2022, Speedup Strategies, after Bloesch et al. 2015): the
 /// camera rotation between two times, integrated from the gyro, moves a
 /// feature as if it were infinitely far away:
 ///   R_B0_B1 = Π Exp(ω_k Δt_k)         (ω linearly interpolated, midpoint rule)

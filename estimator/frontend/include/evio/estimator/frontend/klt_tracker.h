@@ -1,6 +1,6 @@
 #pragma once
 /// @file klt_tracker.h
-/// The frame-based KLT-VIO frontend (ALGORITHMS.md, KLT-VIO): FAST corners,
+/// The frame-based KLT-VIO frontend (docs/algorithms.md#klt): FAST corners,
 /// pyramidal Lucas–Kanade between consecutive frames, and RANSAC on the
 /// fundamental matrix (8-point model) to reject outliers. The RANSAC
 /// threshold is a distance in pixels of an ideal pinhole camera with the

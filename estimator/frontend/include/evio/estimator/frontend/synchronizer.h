@@ -1,7 +1,7 @@
 #pragma once
 /// @file synchronizer.h
 /// Asynchronous feature tracks → synchronous measurement sets for the filter
-/// (eklt-vio-paper.tex, Frontend Adaptations; ALGORITHMS.md, Synchronisation).
+/// (Mahlknecht et al. 2022, Frontend Adaptations; docs/algorithms.md#synchronisation).
 ///
 /// Triggers:
 ///  - "events": every n_e events in total, if any track moved since the last

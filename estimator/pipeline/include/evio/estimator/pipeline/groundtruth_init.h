@@ -1,7 +1,7 @@
 #pragma once
 /// @file groundtruth_init.h
-/// The paper's initialisation protocol (eklt-vio-paper.tex, Experiments;
-/// ALGORITHMS.md): the filter starts from the ground-truth pose and velocity
+/// The paper's initialisation protocol (Mahlknecht et al. 2022, Experiments;
+/// docs/algorithms.md#ground-truth-initialisation): the filter starts from the ground-truth pose and velocity
 /// with zero IMU biases.
 ///
 /// groundtruth.txt holds T_W_C(t), the camera (event camera) in W on the

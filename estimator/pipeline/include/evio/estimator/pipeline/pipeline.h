@@ -1,9 +1,9 @@
 #pragma once
 /// @file pipeline.h
-/// The estimator pipelines (eklt-vio-paper.tex; ALGORITHMS.md): EKLT-VIO
+/// The estimator pipelines (Mahlknecht et al. 2022; docs/architecture.md#the-estimator-stages): EKLT-VIO
 /// (EKLT frontend + synchroniser + EKF backend), KLT-VIO (KLT frontend +
 /// backend updated per frame) and `tracks` (backend on feature tracks read
-/// from a file), run over a sequence folder (DESIGN.md layout, recorded or
+/// from a file), run over a sequence folder (docs/architecture.md#the-sequence-folder, recorded or
 /// simulated) and written as an estimate folder (estimate_writer.h).
 ///
 /// Streaming (memory flat in the sequence length): events in chunks, IMU one

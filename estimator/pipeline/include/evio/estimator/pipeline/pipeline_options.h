@@ -7,7 +7,7 @@
 /// (core/io/config.h), e.g. `frontend.eklt.patch_size_px=17`,
 /// `backend.max_slam_features=15`, `sync.n_e=3200`.
 ///
-/// Methods (eklt-vio-paper.tex; ALGORITHMS.md):
+/// Methods (Mahlknecht et al. 2022; docs/architecture.md#the-estimator-stages):
 ///  - `eklt-vio`: EKLT on events and frames (or frames reconstructed from
 ///    events, `frontend.image_source: reconstructed`), synchroniser trigger
 ///    every n_e events, backend update per measurement set;

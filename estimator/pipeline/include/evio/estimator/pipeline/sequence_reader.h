@@ -1,6 +1,6 @@
 #pragma once
 /// @file sequence_reader.h
-/// Streams a sequence folder (DESIGN.md layout) in time order: event chunks
+/// Streams a sequence folder (docs/architecture.md#the-sequence-folder) in time order: event chunks
 /// (events.h5 when present, else events.txt), frames (images.txt, loaded on
 /// demand), IMU samples (imu.txt) and, when asked for, laser range-finder
 /// readings (range.txt, camera clock), merged on the camera clock. Memory

@@ -12,6 +12,7 @@
 #include "evio/estimator/backend/feature_selection.h"
 #include "evio/estimator/backend/msckf_updater.h"
 #include "evio/estimator/backend/slam_updater.h"
+#include "evio/estimator/backend/visual_models.h"
 
 namespace evio::estimator {
 namespace {
@@ -197,6 +198,85 @@ TEST(BackendUpdaters, MsckfUsesEveryChosenTrackOnceAndCountsWhyNot) {
   EXPECT_EQ(b.stats.msckf_features_no_parallax + b.stats.msckf_triangulation_failed, 2);
   EXPECT_TRUE(tracks[1].observations.empty());
   EXPECT_TRUE(tracks[2].observations.empty());
+}
+
+/// Clones along +x of W (identity attitude: the cameras look along +z of W).
+FilterState cloneRow(const std::vector<double>& x_m, double p_var = 1e-4) {
+  FilterState s = restingState(static_cast<int>(x_m.size()), p_var);
+  for (std::size_t i = 0; i < x_m.size(); ++i) s.clones[i].p_W_C = s.clones[i].p_fej = Vec3(x_m[i], 0, 0);
+  return s;
+}
+
+TEST(BackendUpdaters, MsckfGivesTwoNMinusThreeRowsAndZeroResidualsForExactObservations) {
+  // A point 1 m ahead seen from three clones 0.25 m apart: 50 px of parallax at f = 100 px.
+  UpdaterBench b(cloneRow({0.0, 0.25, 0.5}));
+  const Vec3 p_W(0.25, 0.1, 1.0);
+  FeatureTrack t;
+  t.id = 4;
+  for (const CameraClone& c : b.state.clones) {
+    Vec2 z;
+    ASSERT_TRUE(projectWorldPoint(c, p_W, &z));
+    t.observations.push_back({c.id, z});
+  }
+  TrackMap tracks{{4, t}};
+  MsckfUpdater msckf(b.context(), kCamera, 1e-4, &b.chi2);
+  const UpdateRows rows = msckf.residuals({4}, &tracks);
+  ASSERT_EQ(rows.H.rows(), 3);  // 2n − 3, n = 3
+  EXPECT_EQ(rows.H.cols(), b.state.dim());
+  EXPECT_LT(rows.r.norm(), 1e-9);
+  EXPECT_EQ(msckf.lastCount(), 1);
+  EXPECT_EQ(b.stats.msckf_features_used, 1);
+  EXPECT_TRUE(tracks[4].observations.empty());
+}
+
+TEST(BackendUpdaters, SlamGateAcceptsThePredictionAndGatesOutRepeatedOutliers) {
+  // Feature (α, β, ρ) = (0.1, −0.2, 0.5) anchored in clone 0; clone 1 at the same pose sees it at (α, β).
+  UpdaterBench b(cloneRow({0.0, 0.0}));
+  SlamFeature f;
+  f.id = 9;
+  f.anchor_clone_id = 0;
+  f.abr = Vec3(0.1, -0.2, 0.5);
+  b.state.features.push_back(f);
+  b.state.P = 1e-4 * MatX::Identity(b.state.dim(), b.state.dim());
+  b.options.slam_max_gate_failures = 2;
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  SlamGate g = slam.gate({{9, Vec2(0.1, -0.2)}, {5, Vec2::Zero()}}, 1);  // 5 is no SLAM feature
+  ASSERT_EQ(g.accepted.size(), 1u);
+  EXPECT_EQ(g.accepted[0].id, 9);
+  EXPECT_TRUE(g.gated_out.empty());
+  MatX H;
+  VecX r;
+  slam.relinearize(b.state, g.accepted, 1, &H, &r);
+  ASSERT_EQ(H.rows(), 2);
+  EXPECT_LT(r.norm(), 1e-12);
+  const std::vector<FeatureObservation> outlier{{9, Vec2(0.6, 0.3)}};  // 0.5 away, σ 0.01
+  g = slam.gate(outlier, 1);
+  EXPECT_TRUE(g.accepted.empty());
+  EXPECT_TRUE(g.gated_out.empty());  // one failure of two
+  g = slam.gate(outlier, 1);
+  EXPECT_EQ(g.gated_out, (std::vector<std::size_t>{0}));
+  EXPECT_EQ(b.stats.slam_updates_rejected, 2);
+  slam.marginalizeUnobserved({});
+  EXPECT_TRUE(b.state.features.empty());
+  EXPECT_EQ(b.stats.slam_features_removed, 1);
+}
+
+TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheDepthPrior) {
+  // Two clones at one pose: no parallax, so the track enters with ρ0 = 1/(2 d_min), σ = 1/(4 d_min).
+  UpdaterBench b(cloneRow({0.0, 0.0}));
+  b.options.slam_min_depth_m = 0.5;
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  TrackMap tracks{{3, track(3, {0, 1})}};
+  tracks[3].observations.back().z = Vec2(0.2, 0.1);
+  ASSERT_TRUE(slam.initialize({3, 8}, &tracks));  // 8 has no track: skipped
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_EQ(b.state.features[0].id, 3);
+  EXPECT_EQ(b.state.features[0].anchor_clone_id, 1);
+  EXPECT_TRUE(b.state.features[0].abr.isApprox(Vec3(0.2, 0.1, 1.0)));
+  const int j = b.state.featureIndex(0);
+  EXPECT_NEAR(b.state.P(j + 2, j + 2), 0.5 * 0.5, 1e-15);
+  EXPECT_EQ(b.stats.slam_initialized_prior, 1);
+  EXPECT_TRUE(tracks.empty());
 }
 
 }  // namespace

@@ -145,7 +145,8 @@ JsonValue metricsJson(const Metrics& m, const EvaluationOptions& options, const 
   }
 
   JsonValue& dv = j.set("divergence", JsonValue::object());
-  dv.set("alignment", JsonValue::string(tag));
+  dv.set("alignment",
+         JsonValue::string(options.divergence.use_alignment ? tag : "none (divergence.use_alignment false)"));
   dv.set("diverged", JsonValue::boolean(m.divergence.diverged));
   dv.set("time_s", m.divergence.diverged ? JsonValue::number(m.divergence.time_s) : JsonValue::null());
   dv.set("cause", JsonValue::string(m.divergence.cause));

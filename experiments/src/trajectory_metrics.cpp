@@ -73,6 +73,14 @@ double completion(const std::vector<PoseError>& errors, const Trajectory& gt, co
 
 }  // namespace
 
+EvaluationOptions EvaluationOptions::paper() {
+  EvaluationOptions o;
+  o.alignment = AlignmentOptions::paper();
+  o.nees.use_alignment = false;
+  o.divergence.use_alignment = false;
+  return o;
+}
+
 Metrics evaluateTrajectory(const EvaluationInputs& in, const EvaluationOptions& options) {
   options.validate();
   require(!in.groundtruth.empty(), "evaluate: the ground truth has no poses");
@@ -94,8 +102,12 @@ Metrics evaluateTrajectory(const EvaluationInputs& in, const EvaluationOptions& 
   m.rpe = relativePoseError(association, m.alignment, m.groundtruth_length_m, options.rpe);
   m.nees = poseNees(association, m.alignment, in.covariance, options.nees);
   if (in.timing) m.rtf = realTimeFactor(*in.timing, options.rtf_grid_s);
-  m.divergence = divergence(m.pose_errors, in.status, options.divergence);
-  m.completion = completion(m.pose_errors, in.groundtruth, m.divergence, in.status, options.completion_max_gap_s);
+  // Divergence and completion: on the aligned errors, or in the estimate's own frame.
+  const std::vector<PoseError> unaligned =
+      options.divergence.use_alignment ? std::vector<PoseError>{} : poseErrors(association, Alignment{});
+  const std::vector<PoseError>& judged = options.divergence.use_alignment ? m.pose_errors : unaligned;
+  m.divergence = divergence(judged, in.status, options.divergence);
+  m.completion = completion(judged, in.groundtruth, m.divergence, in.status, options.completion_max_gap_s);
 
   if (in.status && in.status->code == io::EstimateStatus::Code::kFailed) {
     m.status = "failed";

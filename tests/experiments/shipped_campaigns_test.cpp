@@ -17,6 +17,7 @@
 #include "evio/estimator/pipeline/pipeline.h"
 #include "evio/experiments/campaign.h"
 #include "evio/experiments/campaign_runner.h"
+#include "evio/experiments/trajectory_metrics.h"
 #include "evio/simulator/scenario.h"
 
 namespace evio::experiments {
@@ -91,6 +92,29 @@ TEST(ShippedCampaigns, EveryJobHasAValidScenarioAndEstimatorSettings) {
     }
   }
   EXPECT_GE(campaigns, 6);  // main, paper_table, rotation_only, mars, update_rate, speedup
+}
+
+TEST(ShippedCampaigns, ScoreExactlyAsEvaluatePaperDoes) {
+  // Every shipped campaign starts its filters from ground truth and scores
+  // them by the paper's protocol: its evaluation options are
+  // EvaluationOptions::paper() (what `evio evaluate --paper` uses), except
+  // min_spread_m, which rotation-only motion needs (rotation_only, mars).
+  const fs::path root = EVIO_SOURCE_DIR;
+  const EvaluationOptions paper = EvaluationOptions::paper();
+  int campaigns = 0;
+  for (const auto& entry : fs::directory_iterator(root / "experiments" / "campaigns")) {
+    if (entry.path().extension() != ".yaml" || entry.path().stem() == "smoke") continue;  // smoke: a fake estimator
+    SCOPED_TRACE(entry.path().string());
+    ++campaigns;
+    const Campaign c = loadCampaign(entry.path().string());
+    config::Document doc = config::loadString("{}", "<campaign evaluate>");
+    for (const auto& o : asArguments(c.evaluate)) config::applyOverride(doc, o);
+    EvaluationOptions options;
+    config::fill(doc, "", options);
+    options.alignment.min_spread_m = paper.alignment.min_spread_m;
+    EXPECT_TRUE(config::equal(options, paper)) << config::toYaml(options);
+  }
+  EXPECT_GE(campaigns, 6);
 }
 
 }  // namespace

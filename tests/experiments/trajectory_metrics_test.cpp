@@ -191,6 +191,31 @@ TEST(TrajectoryMetrics, DivergenceBoundAndCompletion) {
   EXPECT_EQ(evaluateTrajectory(in, noAlignment()).status, "failed");
 }
 
+TEST(TrajectoryMetrics, PaperScoringJudgesDivergenceInTheFrameTheFilterStartedIn) {
+  // 10 m at 1 m/s; the estimate starts on the truth and from 4.7 s runs away
+  // sideways at 3 m/s: unaligned, 3 (t − 4.7) > 0.1 t + 1 first at
+  // t = (1 + 14.1)/2.9 = 5.2069 s. The paper's alignment (posyaw on 3 … 8 s)
+  // fits the runaway part and drags the start away, so on aligned errors the
+  // run "diverges" from its first poses.
+  EvaluationInputs in;
+  in.groundtruth = test::straightLine(10.0, 0.01, 1.0);
+  for (const auto& p : in.groundtruth) {
+    const double t = nsToSeconds(p.t_ns);
+    const double off = t > 4.7 ? 3.0 * (t - 4.7) : 0.0;
+    in.estimate.push_back({p.t_ns, Pose(p.pose.quaternion(), p.pose.translation() + Vec3(0, off, 0))});
+  }
+  EvaluationOptions aligned = EvaluationOptions::paper();
+  aligned.divergence.use_alignment = true;
+  const Metrics a = evaluateTrajectory(in, aligned);
+  ASSERT_TRUE(a.divergence.diverged);
+  EXPECT_LT(a.divergence.time_s, 1.0);
+  const Metrics m = evaluateTrajectory(in, EvaluationOptions::paper());
+  ASSERT_TRUE(m.divergence.diverged);
+  EXPECT_NEAR(m.divergence.time_s, 15.1 / 2.9, 0.011);  // poses every 10 ms
+  EXPECT_NEAR(m.completion, m.divergence.time_s / 10.0, 0.002);
+  EXPECT_DOUBLE_EQ(m.paper.mpe_percent, a.paper.mpe_percent);  // MPE keeps the paper's alignment
+}
+
 TEST(TrajectoryMetrics, CompletionSkipsGapsAndDriftIsPerMinute) {
   EvaluationInputs in;
   in.groundtruth = test::straightLine(120.0, 0.1, 0.0);  // a hover: L_gt = 0

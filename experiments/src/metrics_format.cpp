@@ -151,6 +151,9 @@ JsonValue metricsJson(const Metrics& m, const EvaluationOptions& options, const 
   dv.set("time_s", m.divergence.diverged ? JsonValue::number(m.divergence.time_s) : JsonValue::null());
   dv.set("cause", JsonValue::string(m.divergence.cause));
   dv.set("max_ratio", JsonValue::number(m.divergence.max_ratio));
+  dv.set("truth_diverged", JsonValue::boolean(m.truth_divergence.diverged));
+  dv.set("truth_time_s",
+         m.truth_divergence.diverged ? JsonValue::number(m.truth_divergence.time_s) : JsonValue::null());
   dv.set("fraction_of_distance", JsonValue::number(options.divergence.fraction_of_distance));
   dv.set("offset_m", JsonValue::number(options.divergence.offset_m));
 

@@ -107,6 +107,7 @@ Metrics evaluateTrajectory(const EvaluationInputs& in, const EvaluationOptions& 
       options.divergence.use_alignment ? std::vector<PoseError>{} : poseErrors(association, Alignment{});
   const std::vector<PoseError>& judged = options.divergence.use_alignment ? m.pose_errors : unaligned;
   m.divergence = divergence(judged, in.status, options.divergence);
+  m.truth_divergence = divergence(judged, std::nullopt, options.divergence);
   m.completion = completion(judged, in.groundtruth, m.divergence, in.status, options.completion_max_gap_s);
 
   if (in.status && in.status->code == io::EstimateStatus::Code::kFailed) {

@@ -59,6 +59,10 @@ TEST(StatusYaml, RoundTripsEveryField) {
   EXPECT_EQ(io::parseStatusYaml(io::formatStatusYaml(s)), s);
   io::EstimateStatus ok;
   EXPECT_EQ(io::parseStatusYaml(io::formatStatusYaml(ok)), ok);
+  io::EstimateStatus degraded = s;
+  degraded.code = io::EstimateStatus::Code::kDegraded;
+  degraded.cause = "self-diagnosis: innovations 31 times their expectation";
+  EXPECT_EQ(io::parseStatusYaml(io::formatStatusYaml(degraded)), degraded);
   test::TempDir dir;
   io::writeStatusYaml(dir.file("status.yaml"), s);
   EXPECT_EQ(io::readStatusYaml(dir.file("status.yaml")), s);
@@ -71,6 +75,7 @@ TEST(StatusYaml, RejectsBadFilesWithLineAndField) {
   EXPECT_EQ(parse("status: ok\n"), "");
   EXPECT_EQ(parse("status: failed\ntime_s: 3.5\ncause: no IMU\n"), "");
   EXPECT_NE(parse("status: diverged\n").find("time_s"), std::string::npos);  // time required
+  EXPECT_NE(parse("status: degraded\n").find("time_s"), std::string::npos);
   EXPECT_NE(parse("status: exploded\ntime_s: 1\n").find("status.yaml:1"), std::string::npos);
   EXPECT_NE(parse("status: ok\ncolour: red\n").find("status.yaml:2"), std::string::npos);
   EXPECT_NE(parse("status: ok\nstatus: ok\n").find("duplicate"), std::string::npos);

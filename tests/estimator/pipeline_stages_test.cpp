@@ -6,6 +6,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/io/tum.h"
+#include "evio/estimator/pipeline/health_monitor.h"
 #include "evio/estimator/pipeline/method.h"
 #include "evio/estimator/pipeline/pipeline_options.h"
 #include "evio/estimator/pipeline/stages.h"
@@ -146,6 +147,90 @@ TEST(PipelineStages, GroundTruthInitializerWaitsForItsTimeAndStartsFromTheTruth)
   GroundTruthInitializer late(gt, 5.0, 0.01, Pose(), 0);
   EXPECT_FALSE(late.offer(100'000'000).has_value());
   EXPECT_THROW(late.offer(5'200'000'000), Error);  // the truth ends at 1.1 s
+}
+
+/// An estimate every 10 ms with the given innovations, position σ 1 cm.
+Estimate update(int k, double nis, int dof, int accepted = 5) {
+  Estimate e;
+  e.t_ns = static_cast<TimeNs>(k) * 10'000'000;
+  e.innovation = InnovationStats{nis, dof, accepted, 0};
+  e.cov_pose_B.diagonal().setConstant(1e-4);
+  return e;
+}
+
+HealthOptions healthOptions() {
+  HealthOptions o;
+  o.window_s = 1.0;
+  o.min_window_dof = 100;
+  o.nis_degraded_ratio = 10.0;
+  o.nis_diverged_ratio = 100.0;
+  o.starvation_s = 0.5;
+  o.max_position_sigma_m = 0.5;
+  return o;
+}
+
+TEST(HealthMonitorStage, ConsistentInnovationsAreOkAndEstimatesPassUnchanged) {
+  HealthMonitor monitor(healthOptions());
+  std::vector<Estimate> out;
+  for (int k = 0; k < 500; ++k) {
+    Estimate e = update(k, 20.0, 20);  // ρ = 1 exactly
+    monitor.process(e, out);
+  }
+  EXPECT_EQ(monitor.verdict().code, io::EstimateStatus::Code::kOk);
+  ASSERT_EQ(out.size(), 500u);
+  EXPECT_EQ(out[123].t_ns, 1'230'000'000);
+  EXPECT_EQ(out[123].innovation.nis, 20.0);
+}
+
+TEST(HealthMonitorStage, TheWindowedRatioGivesDegradedThenDivergedAtTheirFirstTimes) {
+  // ρ = 1 until update 200, then each update carries nis = 50·dof: the window
+  // of 1 s (100 updates, 2000 dof) holds n such updates after n steps, so
+  // ρ = (49 n + 100)/100 > 10 first at n = 19 (t = 2.18 s). Then nis = 500·dof
+  // from update 400: ρ = (450 m + 5000)/100 > 100 first at m = 12 (t = 4.11 s).
+  HealthMonitor monitor(healthOptions());
+  std::vector<Estimate> out;
+  for (int k = 0; k < 600; ++k) {
+    const double per_dof = k < 200 ? 1.0 : k < 400 ? 50.0 : 500.0;
+    Estimate e = update(k, per_dof * 20.0, 20);
+    monitor.process(e, out);
+    if (k == 399) {
+      EXPECT_EQ(monitor.verdict().code, io::EstimateStatus::Code::kDegraded);
+      EXPECT_EQ(monitor.verdict().t_ns, 2'180'000'000);
+      EXPECT_NE(monitor.verdict().cause.find("innovations"), std::string::npos);
+    }
+  }
+  EXPECT_EQ(monitor.verdict().code, io::EstimateStatus::Code::kDiverged);
+  EXPECT_EQ(monitor.verdict().t_ns, 4'110'000'000);
+}
+
+TEST(HealthMonitorStage, StarvationAndCovarianceGrowthAreDegraded) {
+  HealthMonitor starving(healthOptions());
+  std::vector<Estimate> out;
+  for (int k = 0; k < 200; ++k) {
+    Estimate e = update(k, 0.0, 0, k < 100 ? 5 : 0);  // nothing accepted from 1 s on
+    starving.process(e, out);
+  }
+  EXPECT_EQ(starving.verdict().code, io::EstimateStatus::Code::kDegraded);
+  EXPECT_EQ(starving.verdict().t_ns, 1'500'000'000);  // first over 0.5 s after the last accepted at 0.99 s
+  EXPECT_NE(starving.verdict().cause.find("no feature accepted"), std::string::npos);
+
+  HealthMonitor growing(healthOptions());
+  for (int k = 0; k < 100; ++k) {
+    Estimate e = update(k, 20.0, 20);
+    e.cov_pose_B(1, 1) = 0.01 * k * k * 1e-2;  // σ_y = 0.01 k m: above 0.5 m first at k = 51
+    growing.process(e, out);
+  }
+  EXPECT_EQ(growing.verdict().code, io::EstimateStatus::Code::kDegraded);
+  EXPECT_EQ(growing.verdict().t_ns, 510'000'000);
+
+  HealthOptions off = healthOptions();
+  off.enabled = false;
+  HealthMonitor silent(off);
+  for (int k = 0; k < 200; ++k) {
+    Estimate e = update(k, 1e6, 20, 0);
+    silent.process(e, out);
+  }
+  EXPECT_EQ(silent.verdict().code, io::EstimateStatus::Code::kOk);
 }
 
 }  // namespace

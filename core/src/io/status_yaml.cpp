@@ -34,6 +34,7 @@ void validate(const EstimateStatus& s, const std::string& where) {
 std::string_view estimateStatusName(EstimateStatus::Code code) {
   switch (code) {
     case EstimateStatus::Code::kOk: return "ok";
+    case EstimateStatus::Code::kDegraded: return "degraded";
     case EstimateStatus::Code::kDiverged: return "diverged";
     case EstimateStatus::Code::kFailed: return "failed";
   }
@@ -42,9 +43,10 @@ std::string_view estimateStatusName(EstimateStatus::Code code) {
 
 EstimateStatus::Code parseEstimateStatusName(std::string_view name) {
   if (name == "ok") return EstimateStatus::Code::kOk;
+  if (name == "degraded") return EstimateStatus::Code::kDegraded;
   if (name == "diverged") return EstimateStatus::Code::kDiverged;
   if (name == "failed") return EstimateStatus::Code::kFailed;
-  throw Error("status: must be ok, diverged or failed (got '" + std::string(name) + "')");
+  throw Error("status: must be ok, degraded, diverged or failed (got '" + std::string(name) + "')");
 }
 
 EstimateStatus parseStatusYaml(const std::string& text, const std::string& name) {
@@ -65,7 +67,7 @@ EstimateStatus parseStatusYaml(const std::string& text, const std::string& name)
   try {
     s.code = parseEstimateStatusName(scalarAs<std::string>(doc, status, "status"));
   } catch (const Error&) {
-    throwAt(doc, status, "status", "must be ok, diverged or failed");
+    throwAt(doc, status, "status", "must be ok, degraded, diverged or failed");
   }
   if (const YAML::Node t = root["time_s"]; t.IsDefined() && !t.IsNull()) s.t_ns = timeAt(doc, t, "time_s");
   if (const YAML::Node c = root["cause"]; c.IsDefined() && !c.IsNull()) s.cause = scalarAs<std::string>(doc, c, "cause");

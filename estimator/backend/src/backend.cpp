@@ -337,6 +337,7 @@ Estimate Backend::makeEstimate() const {
   e.num_clones = static_cast<int>(state_.clones.size());
   e.num_slam_features = static_cast<int>(state_.features.size());
   e.num_msckf_features = msckf_.lastCount();
+  e.innovation = innovation_;
   return e;
 }
 

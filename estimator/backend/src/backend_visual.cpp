@@ -12,6 +12,7 @@ namespace evio::estimator {
 
 void Backend::processMeasurementSet(const MeasurementSet& set) {
   ++stats_.measurement_sets;
+  innovation_ = InnovationStats{};
   augmentClone();
   const std::size_t c = state_.clones.size() - 1;
   const std::int64_t clone_id = state_.clones[c].id;

@@ -24,7 +24,7 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
       continue;
     }
     constrain(&res.H);
-    if (!passesGate(res.H, res.r, sigma2_, (*chi2_)(static_cast<int>(res.r.size())))) {
+    if (!passesRecordedGate(res.H, res.r, sigma2_, (*chi2_)(static_cast<int>(res.r.size())))) {
       ++stats().msckf_features_rejected;
       continue;
     }

@@ -37,7 +37,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
       constrain(&Hc);
     }
     SlamFeature& f = state().features[jj];
-    if (!ok || !passesGate(Hc, r, sigma2, (*slam_chi2_)(2))) {
+    if (!ok || !passesRecordedGate(Hc, r, sigma2, (*slam_chi2_)(2))) {
       ++stats().slam_updates_rejected;
       if (++f.gate_failures >= options().slam_max_gate_failures) out.gated_out.push_back(jj);
       continue;

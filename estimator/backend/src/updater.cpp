@@ -1,5 +1,7 @@
 #include "evio/estimator/backend/updater.h"
 
+#include <cmath>
+
 #include "evio/estimator/backend/ekf_update.h"
 
 namespace evio::estimator {
@@ -12,6 +14,19 @@ void Updater::constrain(MatX* H) const {
 
 bool Updater::passesGate(const MatX& H, const VecX& r, double sigma2, double threshold) const {
   return !(mahalanobisSquared(H, r, state().P, sigma2) > threshold);  // NaN passes, as it always did
+}
+
+bool Updater::passesRecordedGate(const MatX& H, const VecX& r, double sigma2, double threshold) const {
+  const double m = mahalanobisSquared(H, r, state().P, sigma2);
+  const bool pass = !(m > threshold);  // NaN passes, as it always did
+  if (InnovationStats* s = ctx_.innovation) {
+    if (std::isfinite(m)) {
+      s->nis += m;
+      s->dof += static_cast<int>(r.size());
+    }
+    ++(pass ? s->accepted : s->rejected);
+  }
+  return pass;
 }
 
 bool Updater::constrainAndUpdate(MatX H, const VecX& r, double sigma2) const {

@@ -1,5 +1,7 @@
 #include "evio/estimator/pipeline/estimate_writer.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "evio/core/error.h"
@@ -41,6 +43,11 @@ EstimateWriter::EstimateWriter(std::string folder, const PipelineOutputOptions& 
     imu_state_ = std::make_unique<io::ImuStateWriter>(path("imu_state.txt"), h);
   }
   timing_ = std::make_unique<io::TimingWriter>(path("timing.txt"));
+  if (options_.health) {
+    std::vector<std::string> h = header_;
+    h.push_back("innovations of each visual update; t nis dof accepted rejected slam msckf sigma_p_m");
+    health_ = std::make_unique<io::HealthWriter>(path("health.txt"), h);
+  }
 }
 
 EstimateWriter::~EstimateWriter() = default;
@@ -61,6 +68,12 @@ void EstimateWriter::addEstimate(const Estimate& e) {
     c.cov_position = S.topLeftCorner<3, 3>();
     c.cov_orientation = S.bottomRightCorner<3, 3>();
     covariance_.push_back(c);
+  }
+  if (health_) {
+    const InnovationStats& n = e.innovation;
+    const double var_p = e.cov_pose_B.diagonal().head<3>().maxCoeff();
+    health_->append(io::HealthRow{t, n.nis, n.dof, n.accepted, n.rejected, e.num_slam_features,
+                                  e.num_msckf_features, std::sqrt(std::max(var_p, 0.0))});
   }
   if (imu_state_) {
     io::ImuTruthState s;
@@ -86,6 +99,7 @@ void EstimateWriter::finish(const io::EstimateStatus& status, const std::string&
   trajectory_->close();
   if (options_.covariance) io::writeTumCovariance(path("trajectory_covariance.txt"), covariance_, header_);
   if (imu_state_) imu_state_->close();
+  if (health_) health_->close();
   timing_->close();
   io::writeFileAtomic(path("config.yaml"), config_yaml);
   io::writeFileAtomic(path("summary.yaml"), summary_yaml);

@@ -92,12 +92,14 @@ class PipelineRun {
   std::unique_ptr<TracksStage> tracks_;  // replaces prefilter, frontend and synchroniser for `tracks`
   std::unique_ptr<Backend> backend_;
   std::unique_ptr<BackendStage> backend_stage_;
+  std::unique_ptr<HealthMonitor> health_;
   std::unique_ptr<EstimateWriter> writer_;
   // Each stage's outputs, reused from item to item.
   std::vector<SequenceItem> filtered_;
   std::vector<FrontendOutput> tracked_;
   std::vector<BackendInput> backend_inputs_;
   std::vector<Estimate> estimates_;
+  std::vector<Estimate> checked_;
 
   // Loop state
   Stopwatch run_watch_;
@@ -206,6 +208,7 @@ void PipelineRun::setupStages() {
     result_.notes.push_back("static initialisation: position and yaw zero, the estimate needs alignment");
   }
   backend_stage_ = std::make_unique<BackendStage>(*backend_, std::move(initializer));
+  health_ = std::make_unique<HealthMonitor>(options_.health);
 }
 
 void PipelineRun::runStages(SequenceItem& item) {
@@ -228,8 +231,10 @@ void PipelineRun::runStages(SequenceItem& item) {
     StageTimer timer(&result_.times.backend_s);
     for (BackendInput& in : backend_inputs_) backend_stage_->process(in, estimates_);
   }
+  checked_.clear();
+  for (Estimate& e : estimates_) health_->process(e, checked_);
   StageTimer timer(&result_.times.output_s);
-  for (const Estimate& e : estimates_) writer_->addEstimate(e);
+  for (const Estimate& e : checked_) writer_->addEstimate(e);
 }
 
 void PipelineRun::afterItem(TimeNs t_ns) {
@@ -308,6 +313,11 @@ io::EstimateStatus PipelineRun::finalStatus() const {
     status.cause = bs.cause;
   } else if (pipeline_failure_) {
     status = *pipeline_failure_;
+  } else if (health_->verdict().code != io::EstimateStatus::Code::kOk) {
+    const HealthVerdict& v = health_->verdict();
+    status.code = v.code;
+    status.t_ns = v.t_ns - offset_ns_;
+    status.cause = v.cause;
   } else if (!backend_->initialized()) {
     status.code = io::EstimateStatus::Code::kFailed;
     status.t_ns = t_now_;

@@ -65,6 +65,7 @@ void PipelineOptions::validate() const {
   validateSection("init", init);
   validateSection("calibration", calibration);
   validateSection("tracks", tracks);
+  validateSection("health", health);
   validateSection("output", output);
   const MethodInfo& info = methodInfo(*m);
   if (*info.tracker)

@@ -4,7 +4,7 @@
 ///
 /// metrics.json ("format": "evio-metrics/1"), keys in this order:
 ///   format, inputs{estimate, groundtruth, covariance, timing, status}  (paths or null)
-///   status (ok|diverged|failed), cause, estimator_status (ok|diverged|failed|unknown)
+///   status (ok|diverged|failed), cause, estimator_status (ok|degraded|diverged|failed|unknown)
 ///   association{estimate_poses, groundtruth_poses, matched_poses, matched_share,
 ///               max_time_difference_s, time_offset_s}
 ///   groundtruth{duration_s, length_m}

@@ -109,7 +109,7 @@ struct DivergenceResult {
 struct Metrics {
   std::string status = "ok";         ///< ok | diverged | failed
   std::string cause;                 ///< why not ok
-  std::string estimator_status = "unknown";  ///< from status.yaml: ok | diverged | failed | unknown
+  std::string estimator_status = "unknown";  ///< from status.yaml: ok | degraded | diverged | failed | unknown
   std::size_t estimate_poses = 0;
   std::size_t groundtruth_poses = 0;
   std::size_t matched_poses = 0;
@@ -125,6 +125,9 @@ struct Metrics {
   NeesMetrics nees;
   RtfMetrics rtf;
   DivergenceResult divergence;
+  /// The ground truth's verdict alone (the error bound, not status.yaml):
+  /// what the estimator's self-diagnosis is measured against.
+  DivergenceResult truth_divergence;
   std::vector<PoseError> pose_errors;  ///< per associated pose (series for plots)
 };
 

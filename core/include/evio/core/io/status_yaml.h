@@ -4,7 +4,7 @@
 /// its trajectory and read by `evio evaluate` (divergence, completion) and by
 /// campaigns (success rates). Divergence is a status, not an abort.
 ///
-///   status: diverged          # ok | diverged | failed (required)
+///   status: diverged          # ok | degraded | diverged | failed (required)
 ///   time_s: 12.345            # data time (sequence clock, s) of the divergence
 ///                             # or failure; required unless status is ok
 ///   cause: "velocity above 100 m/s"   # one line; optional ("" when ok)
@@ -23,7 +23,9 @@
 namespace evio::io {
 
 struct EstimateStatus {
-  enum class Code { kOk, kDiverged, kFailed };
+  /// kDegraded: the run went on to the end, but the estimator's
+  /// self-diagnosis judged its estimate unreliable from t_ns on.
+  enum class Code { kOk, kDegraded, kDiverged, kFailed };
   Code code = Code::kOk;
   std::optional<TimeNs> t_ns;                 ///< time of divergence/failure (sequence clock)
   std::string cause;                          ///< one line
@@ -33,7 +35,7 @@ struct EstimateStatus {
   friend bool operator==(const EstimateStatus&, const EstimateStatus&) = default;
 };
 
-/// "ok", "diverged" or "failed".
+/// "ok", "degraded", "diverged" or "failed".
 std::string_view estimateStatusName(EstimateStatus::Code code);
 
 /// Inverse of estimateStatusName; throws evio::Error "status: ..." otherwise.

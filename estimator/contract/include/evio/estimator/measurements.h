@@ -87,6 +87,17 @@ struct ImuState {
   Pose T_W_B() const { return Pose(q_W_B, p_W_B); }
 };
 
+/// The innovations of one visual update, for self-diagnosis: every gated
+/// feature's normalised innovation squared rᵀ S⁻¹ r (S = H P Hᵀ + σ² I),
+/// summed with its degrees of freedom, whether the gate accepted it or not.
+/// For a consistent filter E[nis] = dof.
+struct InnovationStats {
+  double nis = 0.0;       ///< Σ rᵀ S⁻¹ r over the gated features
+  int dof = 0;            ///< Σ residual dimensions
+  int accepted = 0;       ///< features the gates let into the update
+  int rejected = 0;       ///< features the gates turned away
+};
+
 /// The filter's estimate at one time, with the covariances the writer reports.
 struct Estimate {
   TimeNs t_ns = 0;   ///< IMU clock
@@ -102,6 +113,7 @@ struct Estimate {
   int num_clones = 0;
   int num_slam_features = 0;
   int num_msckf_features = 0;  ///< MSCKF features used in this update
+  InnovationStats innovation;  ///< of the visual update that produced this estimate
 };
 
 }  // namespace evio::estimator

@@ -125,7 +125,7 @@ class Backend {
   void checkHealth();
   void setStatus(BackendStatus::Code code, const std::string& cause);
   Estimate makeEstimate() const;
-  UpdaterContext updaterContext() { return UpdaterContext{&state_, &fej_imu_, &options_, &stats_}; }
+  UpdaterContext updaterContext() { return UpdaterContext{&state_, &fej_imu_, &options_, &stats_, &innovation_}; }
 
   BackendOptions options_;
   BackendSensors sensors_;
@@ -158,6 +158,7 @@ class Backend {
   std::uint64_t next_seq_ = 0;
   TrackMap tracks_;
   std::vector<Estimate> estimates_;
+  InnovationStats innovation_;  // of the visual update under way
 
   // The updaters (updater.h), on state_, fej_imu_, options_ and stats_.
   RangeUpdater range_;

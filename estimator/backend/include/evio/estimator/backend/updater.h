@@ -14,6 +14,7 @@
 #include "evio/estimator/backend/backend_status.h"
 #include "evio/estimator/backend/filter_state.h"
 #include "evio/estimator/backend/triangulation.h"
+#include "evio/estimator/measurements.h"
 
 namespace evio::estimator {
 
@@ -25,6 +26,8 @@ struct UpdaterContext {
   const ImuState* fej_imu = nullptr;
   const BackendOptions* options = nullptr;
   BackendStats* stats = nullptr;
+  /// The innovations of the visual update under way (measurements.h).
+  InnovationStats* innovation = nullptr;
 };
 
 /// Residual rows of a stacked update.
@@ -51,6 +54,9 @@ class Updater {
  protected:
   /// The Mahalanobis test rᵀ (H P Hᵀ + σ² I)⁻¹ r ≤ threshold (a χ² quantile).
   bool passesGate(const MatX& H, const VecX& r, double sigma2, double threshold) const;
+  /// The same test, with the statistic recorded in the context's innovation
+  /// stats (visual updates: self-diagnosis).
+  bool passesRecordedGate(const MatX& H, const VecX& r, double sigma2, double threshold) const;
   /// Constrains H, then the EKF update (ekf_update.h); false when the
   /// innovation covariance is not positive definite (state unchanged).
   bool constrainAndUpdate(MatX H, const VecX& r, double sigma2) const;

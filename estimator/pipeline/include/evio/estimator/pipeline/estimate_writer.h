@@ -15,6 +15,9 @@
 ///                              p_W_B, q_W_B, v_W, biases; ω and a are not
 ///                              estimated and written as 0
 ///   timing.txt                 core/io/timing_txt.h (real-time factor)
+///   health.txt                 core/io/health_txt.h: the innovations and
+///                              feature counts of every visual update
+///                              (self-diagnosis; output.health)
 ///   status.yaml                core/io/status_yaml.h
 ///   config.yaml                the resolved configuration
 ///   summary.yaml               per-stage wall-clock times and counters
@@ -26,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "evio/core/io/health_txt.h"
 #include "evio/core/io/imu_state_txt.h"
 #include "evio/core/io/status_yaml.h"
 #include "evio/core/io/timing_txt.h"
@@ -70,6 +74,7 @@ class EstimateWriter {
   std::unique_ptr<io::TumWriter> trajectory_;
   std::unique_ptr<io::ImuStateWriter> imu_state_;
   std::unique_ptr<io::TimingWriter> timing_;
+  std::unique_ptr<io::HealthWriter> health_;
   std::vector<io::StampedPoseCovariance> covariance_;  // no streaming writer in core/io: 20 doubles per pose
   std::size_t num_poses_ = 0;
   TimeNs last_t_ns_ = 0;

@@ -28,6 +28,7 @@
 #include "evio/estimator/backend/backend_options.h"
 #include "evio/estimator/frontend/frontend.h"
 #include "evio/estimator/frontend/synchronizer.h"
+#include "evio/estimator/pipeline/health_monitor.h"
 #include "evio/estimator/pipeline/method.h"
 
 namespace evio::estimator {
@@ -118,6 +119,7 @@ struct TracksInputOptions {
 struct PipelineOutputOptions {
   bool covariance = true;          ///< trajectory_covariance.txt
   bool imu_state = true;           ///< imu_state.txt (p, q, v, biases of B)
+  bool health = true;              ///< health.txt (innovations of each visual update)
   double timing_interval_s = 0.1;  ///< a timing.txt line at least this often (data time), s
   /// Clock of timing.txt's processing_s: `wall` (steady clock, what timing.txt
   /// specifies) or `cpu` (CPU time of the process, all threads: std::clock),
@@ -130,6 +132,7 @@ struct PipelineOutputOptions {
   void fields(V& v) {
     v("covariance", covariance, "write trajectory_covariance.txt");
     v("imu_state", imu_state, "write imu_state.txt");
+    v("health", health, "write health.txt");
     v("timing_interval_s", timing_interval_s, "timing.txt line interval, s of data time");
     v("timing_clock", timing_clock, "wall or cpu: the clock of timing.txt");
     v("stop_on_divergence", stop_on_divergence, "stop at divergence or failure");
@@ -146,6 +149,7 @@ struct PipelineOptions {
   InitOptions init;
   CalibrationOptions calibration;
   TracksInputOptions tracks;
+  HealthOptions health;
   PipelineOutputOptions output;
 
   template <class V>
@@ -158,6 +162,7 @@ struct PipelineOptions {
     v("init", init, "initialisation");
     v("calibration", calibration, "calibration when the sequence has no sensors.yaml");
     v("tracks", tracks, "tracks input (method tracks)");
+    v("health", health, "self-diagnosis without ground truth");
     v("output", output, "outputs");
   }
   /// Throws evio::Error naming the field (nested fields with their path,

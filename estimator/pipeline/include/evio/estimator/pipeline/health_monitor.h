@@ -1,0 +1,87 @@
+#pragma once
+/// @file health_monitor.h
+/// The estimator's self-diagnosis without ground truth
+/// (docs/evaluation.md#self-diagnosis): a stage between the backend and the
+/// writer that watches every estimate's innovations and covariance and
+/// reports the run `degraded` or `diverged`, with the time and the cause of
+/// the first such verdict. It never changes an estimate and never stops the
+/// filter; its verdict goes into status.yaml.
+///
+/// Signals, over a sliding window of window_s of data time:
+///  - innovation ratio ρ = Σ nis / Σ dof of the gated visual features
+///    (accepted and rejected; Estimate::innovation). A consistent filter has
+///    E[ρ] = 1; ρ above nis_degraded_ratio is `degraded`, above
+///    nis_diverged_ratio `diverged`. Judged once the window holds at least
+///    min_window_dof degrees of freedom;
+///  - feature starvation: no feature accepted by the gates for starvation_s
+///    (after the first accepted one) is `degraded`;
+///  - covariance growth: the body's largest position standard deviation
+///    above max_position_sigma_m is `degraded`.
+
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "evio/core/io/status_yaml.h"
+#include "evio/core/options.h"
+#include "evio/estimator/measurements.h"
+#include "evio/estimator/pipeline/stage.h"
+
+namespace evio::estimator {
+
+struct HealthOptions {
+  bool enabled = true;                 ///< off: status.yaml reports numerical health only
+  double window_s = 2.0;               ///< sliding window of data time, s
+  int min_window_dof = 50;             ///< residual dimensions the window needs before ρ is judged
+  double nis_degraded_ratio = 20.0;    ///< ρ above this: degraded
+  double nis_diverged_ratio = 200.0;   ///< ρ above this: diverged
+  double starvation_s = 1.0;           ///< no accepted feature for this long: degraded, s
+  double max_position_sigma_m = 1.0;   ///< position standard deviation above this: degraded, m
+
+  template <class V>
+  void fields(V& v) {
+    v("enabled", enabled, "judge the run's health from its innovations and covariance");
+    v("window_s", window_s, "sliding window of data time, s");
+    v("min_window_dof", min_window_dof, "residual dimensions the window needs before the ratio is judged");
+    v("nis_degraded_ratio", nis_degraded_ratio, "innovation ratio sum(nis)/sum(dof) above which: degraded");
+    v("nis_diverged_ratio", nis_diverged_ratio, "innovation ratio above which: diverged");
+    v("starvation_s", starvation_s, "no accepted feature for this long: degraded, s");
+    v("max_position_sigma_m", max_position_sigma_m, "position standard deviation above which: degraded, m");
+  }
+  void validate() const;
+};
+
+/// A verdict of the self-diagnosis.
+struct HealthVerdict {
+  io::EstimateStatus::Code code = io::EstimateStatus::Code::kOk;  ///< kOk, kDegraded or kDiverged
+  TimeNs t_ns = 0;       ///< first time the verdict held (IMU clock, as the estimates)
+  std::string cause;     ///< one line
+};
+
+class HealthMonitor : public Stage<Estimate, Estimate> {
+ public:
+  explicit HealthMonitor(const HealthOptions& options);
+  /// Passes the estimate on unchanged after judging it.
+  void process(Estimate& in, std::vector<Estimate>& out) override;
+  /// The worst verdict so far (the first diverged, else the first degraded, else ok).
+  const HealthVerdict& verdict() const { return verdict_; }
+
+ private:
+  struct Update {
+    TimeNs t_ns;
+    double nis;
+    int dof;
+  };
+  void judge(const Estimate& e);
+  void raise(io::EstimateStatus::Code code, TimeNs t_ns, const std::string& cause);
+
+  HealthOptions options_;
+  std::deque<Update> window_;
+  double window_nis_ = 0.0;
+  long window_dof_ = 0;
+  std::optional<TimeNs> last_accepted_ns_;
+  HealthVerdict verdict_;
+};
+
+}  // namespace evio::estimator

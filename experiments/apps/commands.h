@@ -18,5 +18,6 @@ void addReportCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addEstimateCommand(CLI::App& app);
+void addHealthCommand(CLI::App& app);
 
 }  // namespace evio::apps

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   evio::apps::addExportCommand(app);
   evio::apps::addSimulateCommand(app);
   evio::apps::addEstimateCommand(app);
+  evio::apps::addHealthCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -2,6 +2,7 @@
 // own: what each stage passes on, in which order, with exact answers.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <variant>
 
 #include "evio/core/error.h"
@@ -162,11 +163,27 @@ HealthOptions healthOptions() {
   HealthOptions o;
   o.window_s = 1.0;
   o.min_window_dof = 100;
-  o.nis_degraded_ratio = 10.0;
+  o.nis_probability = 0.999;
   o.nis_diverged_ratio = 100.0;
   o.starvation_s = 0.5;
   o.max_position_sigma_m = 0.5;
   return o;
+}
+
+TEST(HealthMonitorStage, TheDegradedTestIsTheChiSquaredQuantileOfTheWindow) {
+  // 100 updates of 20 dof in the window: degraded exactly when Σ nis > χ²₀.₉₉₉(2000).
+  const double q = chi2Quantile(0.999, 2000.0);
+  EXPECT_NEAR(q, 2000.0 + 3.0902 * std::sqrt(4000.0), 15.0);  // normal approximation
+  for (const double total : {q * 0.999, q * 1.001}) {
+    HealthMonitor monitor(healthOptions());
+    std::vector<Estimate> out;
+    for (int k = 0; k < 100; ++k) {
+      Estimate e = update(k, total / 100.0, 20);
+      monitor.process(e, out);
+    }
+    EXPECT_EQ(monitor.verdict().code,
+              total > q ? io::EstimateStatus::Code::kDegraded : io::EstimateStatus::Code::kOk);
+  }
 }
 
 TEST(HealthMonitorStage, ConsistentInnovationsAreOkAndEstimatesPassUnchanged) {
@@ -183,10 +200,11 @@ TEST(HealthMonitorStage, ConsistentInnovationsAreOkAndEstimatesPassUnchanged) {
 }
 
 TEST(HealthMonitorStage, TheWindowedRatioGivesDegradedThenDivergedAtTheirFirstTimes) {
-  // ρ = 1 until update 200, then each update carries nis = 50·dof: the window
-  // of 1 s (100 updates, 2000 dof) holds n such updates after n steps, so
-  // ρ = (49 n + 100)/100 > 10 first at n = 19 (t = 2.18 s). Then nis = 500·dof
-  // from update 400: ρ = (450 m + 5000)/100 > 100 first at m = 12 (t = 4.11 s).
+  // ρ = 1 until update 200 (Σ nis = 2000 over the 1 s window of 100 updates,
+  // 2000 dof: below χ²₀.₉₉₉(2000) = 2200.1), then each update carries
+  // nis = 50·dof: Σ nis = 2000 + 980 n exceeds the quantile at once (n = 1,
+  // t = 2.00 s). Then nis = 500·dof from update 400: ρ = (450 m + 5000)/100
+  // > 100 first at m = 12 (t = 4.11 s).
   HealthMonitor monitor(healthOptions());
   std::vector<Estimate> out;
   for (int k = 0; k < 600; ++k) {
@@ -195,7 +213,7 @@ TEST(HealthMonitorStage, TheWindowedRatioGivesDegradedThenDivergedAtTheirFirstTi
     monitor.process(e, out);
     if (k == 399) {
       EXPECT_EQ(monitor.verdict().code, io::EstimateStatus::Code::kDegraded);
-      EXPECT_EQ(monitor.verdict().t_ns, 2'180'000'000);
+      EXPECT_EQ(monitor.verdict().t_ns, 2'000'000'000);
       EXPECT_NE(monitor.verdict().cause.find("innovations"), std::string::npos);
     }
   }

@@ -1,12 +1,11 @@
 #include "evio/estimator/pipeline/estimate_writer.h"
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/so3.h"
+#include "evio/estimator/pipeline/health_monitor.h"
 
 namespace evio::estimator {
 
@@ -70,10 +69,9 @@ void EstimateWriter::addEstimate(const Estimate& e) {
     covariance_.push_back(c);
   }
   if (health_) {
-    const InnovationStats& n = e.innovation;
-    const double var_p = e.cov_pose_B.diagonal().head<3>().maxCoeff();
-    health_->append(io::HealthRow{t, n.nis, n.dof, n.accepted, n.rejected, e.num_slam_features,
-                                  e.num_msckf_features, std::sqrt(std::max(var_p, 0.0))});
+    io::HealthRow row = healthRow(e);
+    row.t_ns = t;  // camera clock, as trajectory.txt
+    health_->append(row);
   }
   if (imu_state_) {
     io::ImuTruthState s;

@@ -9,10 +9,13 @@
 ///
 /// Signals, over a sliding window of window_s of data time:
 ///  - innovation ratio ρ = Σ nis / Σ dof of the gated visual features
-///    (accepted and rejected; Estimate::innovation). A consistent filter has
-///    E[ρ] = 1; ρ above nis_degraded_ratio is `degraded`, above
-///    nis_diverged_ratio `diverged`. Judged once the window holds at least
-///    min_window_dof degrees of freedom;
+///    (accepted and rejected; Estimate::innovation). For a consistent filter
+///    Σ nis ~ χ²(Σ dof), so E[ρ] = 1. `degraded` when Σ nis exceeds its χ²
+///    quantile of nis_probability (0.999: the innovations are larger than
+///    the filter's own noise model allows, at 99.9 %); `diverged` when ρ
+///    exceeds nis_diverged_ratio. Judged once the window holds at least
+///    min_window_dof degrees of freedom. No threshold is fitted to a
+///    sequence: the χ² test is the filter's own claim;
 ///  - feature starvation: no feature accepted by the gates for starvation_s
 ///    (after the first accepted one) is `degraded`;
 ///  - covariance growth: the body's largest position standard deviation
@@ -23,8 +26,10 @@
 #include <string>
 #include <vector>
 
+#include "evio/core/io/health_txt.h"
 #include "evio/core/io/status_yaml.h"
 #include "evio/core/options.h"
+#include "evio/estimator/backend/chi_squared.h"
 #include "evio/estimator/measurements.h"
 #include "evio/estimator/pipeline/stage.h"
 
@@ -34,8 +39,8 @@ struct HealthOptions {
   bool enabled = true;                 ///< off: status.yaml reports numerical health only
   double window_s = 2.0;               ///< sliding window of data time, s
   int min_window_dof = 50;             ///< residual dimensions the window needs before ρ is judged
-  double nis_degraded_ratio = 20.0;    ///< ρ above this: degraded
-  double nis_diverged_ratio = 200.0;   ///< ρ above this: diverged
+  double nis_probability = 0.999;      ///< Σ nis above its χ²(Σ dof) quantile of this: degraded
+  double nis_diverged_ratio = 10.0;    ///< ρ = Σ nis / Σ dof above this: diverged
   double starvation_s = 1.0;           ///< no accepted feature for this long: degraded, s
   double max_position_sigma_m = 1.0;   ///< position standard deviation above this: degraded, m
 
@@ -44,8 +49,8 @@ struct HealthOptions {
     v("enabled", enabled, "judge the run's health from its innovations and covariance");
     v("window_s", window_s, "sliding window of data time, s");
     v("min_window_dof", min_window_dof, "residual dimensions the window needs before the ratio is judged");
-    v("nis_degraded_ratio", nis_degraded_ratio, "innovation ratio sum(nis)/sum(dof) above which: degraded");
-    v("nis_diverged_ratio", nis_diverged_ratio, "innovation ratio above which: diverged");
+    v("nis_probability", nis_probability, "sum(nis) above its chi-squared(sum(dof)) quantile of this: degraded");
+    v("nis_diverged_ratio", nis_diverged_ratio, "innovation ratio sum(nis)/sum(dof) above which: diverged");
     v("starvation_s", starvation_s, "no accepted feature for this long: degraded, s");
     v("max_position_sigma_m", max_position_sigma_m, "position standard deviation above which: degraded, m");
   }
@@ -59,11 +64,18 @@ struct HealthVerdict {
   std::string cause;     ///< one line
 };
 
+/// One visual update as the monitor sees it (a health.txt row): from an
+/// Estimate while running, or read back from an estimate folder to judge it
+/// again with other options (`evio health`).
+io::HealthRow healthRow(const Estimate& e);
+
 class HealthMonitor : public Stage<Estimate, Estimate> {
  public:
   explicit HealthMonitor(const HealthOptions& options);
   /// Passes the estimate on unchanged after judging it.
   void process(Estimate& in, std::vector<Estimate>& out) override;
+  /// Judges one update (rows in increasing time).
+  void observe(const io::HealthRow& row);
   /// The worst verdict so far (the first diverged, else the first degraded, else ok).
   const HealthVerdict& verdict() const { return verdict_; }
 
@@ -73,10 +85,11 @@ class HealthMonitor : public Stage<Estimate, Estimate> {
     double nis;
     int dof;
   };
-  void judge(const Estimate& e);
+
   void raise(io::EstimateStatus::Code code, TimeNs t_ns, const std::string& cause);
 
   HealthOptions options_;
+  Chi2Table chi2_;
   std::deque<Update> window_;
   double window_nis_ = 0.0;
   long window_dof_ = 0;

@@ -3,7 +3,8 @@
 /// The estimator's stages, in the order data flows (pipeline.h wires them):
 ///
 ///   SequenceReader ─SequenceItem─► PrefilterStage ─SequenceItem─► FrontendStage
-///     ─FrontendOutput─► SynchronizerStage ─BackendInput─► BackendStage ─Estimate─► EstimateWriter
+///     ─FrontendOutput─► SynchronizerStage ─BackendInput─► BackendStage ─Estimate─►
+///     HealthMonitor (health_monitor.h) ─Estimate─► EstimateWriter
 ///
 /// The `tracks` method replaces prefilter, frontend and synchroniser by
 /// TracksStage (SequenceItem → BackendInput). IMU and range readings travel

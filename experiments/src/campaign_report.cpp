@@ -95,6 +95,14 @@ Spread spreadOf(std::vector<double> values) {
   return s;
 }
 
+void SelfDiagnosisAgreement::count(const std::string& estimator_status, const std::string& truth_diverged) {
+  if (truth_diverged != "true" && truth_diverged != "false") return;  // older results: no truth verdict
+  const bool flagged = estimator_status == "degraded" || estimator_status == "diverged";
+  if (!flagged && estimator_status != "ok") return;
+  if (truth_diverged == "true") ++(flagged ? caught : missed);
+  else ++(flagged ? false_alarms : quiet);
+}
+
 CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& rows) {
   require(!rows.empty(), "summary.csv: empty");
   std::map<std::string, std::size_t> col;
@@ -147,6 +155,7 @@ CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& row
       v.ate_p.push_back(number(get("ate.position_m.rmse")));
       v.ate_r.push_back(number(get("ate.rotation_deg.rmse")));
     }
+    if (status != "failed") g.self_diagnosis.count(get("estimator_status"), get("divergence.truth_diverged"));
     if (get("nees.available") == "true") v.nees.push_back(number(get("nees.mean_pose")));
     if (get("rtf.available") == "true") {
       v.rtf.push_back(number(get("rtf.median")));
@@ -250,6 +259,23 @@ std::string comparisonMarkdown(const CampaignReport& report) {
   return s + "\n";
 }
 
+std::string selfDiagnosisMarkdown(const CampaignReport& report) {
+  std::string rows;
+  for (const auto& g : report.groups) {
+    const SelfDiagnosisAgreement& a = g.self_diagnosis;
+    if (a.judged() == 0) continue;
+    rows += "| " + g.scenario + " | " + g.method + " | " + (g.sweep.empty() ? "–" : g.sweep) + " | " +
+            std::to_string(a.judged()) + " | " + std::to_string(a.caught) + " | " + std::to_string(a.missed) + " | " +
+            std::to_string(a.false_alarms) + " | " + std::to_string(a.quiet) + " |\n";
+  }
+  if (rows.empty()) return "";
+  return "\n## Self-diagnosis\n\nThe estimator's own verdict (status.yaml degraded or diverged, without ground "
+         "truth) against the ground truth's (the divergence bound), over the runs that did not fail.\n\n"
+         "| scenario | method | sweep | runs | caught | missed | false alarms | quiet |\n"
+         "|---|---|---|---:|---:|---:|---:|---:|\n" +
+         rows;
+}
+
 std::string reportMarkdown(const CampaignReport& report, const std::string& title,
                            const std::vector<std::string>& figures, const std::vector<std::string>& notes) {
   std::string s = "# " + title + "\n\n";
@@ -287,6 +313,7 @@ std::string reportMarkdown(const CampaignReport& report, const std::string& titl
            (g.rtf_median.count ? fixed(g.rtf_median.median, 2) + " / " + fixed(g.rtf_max, 2) : "–") + " |\n";
     }
   }
+  s += selfDiagnosisMarkdown(report);
   if (!figures.empty()) {
     s += "\n## Figures\n\n";
     for (const auto& f : figures) s += "![" + f + "](" + f + ")\n\n";

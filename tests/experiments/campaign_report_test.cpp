@@ -70,6 +70,29 @@ TEST(CampaignReport, AggregatesRunsPerScenarioMethodAndSweep) {
   EXPECT_EQ(csv[2][2], "x=1");
 }
 
+TEST(CampaignReport, SelfDiagnosisIsCountedAgainstTheTruthsVerdict) {
+  const std::string summary =
+      "job_id,scenario,method,sweep,seed,done,status,estimator_status,divergence.truth_diverged\n"
+      "a1,rot,eklt,,1,1,ok,ok,false\n"             // quiet
+      "a2,rot,eklt,,2,1,ok,degraded,false\n"       // false alarm
+      "a3,rot,eklt,,3,1,diverged,degraded,true\n"  // caught
+      "a4,rot,eklt,,4,1,diverged,ok,true\n"        // missed
+      "a5,rot,eklt,,5,1,diverged,diverged,true\n"  // caught (the estimator's own divergence)
+      "a6,rot,eklt,,6,1,failed,failed,false\n"     // failed: not judged
+      "a7,rot,eklt,,7,1,ok,ok,\n";                 // no truth verdict (older results): not judged
+  const CampaignReport r = aggregateSummary(parseCsv(summary));
+  ASSERT_EQ(r.groups.size(), 1u);
+  const SelfDiagnosisAgreement& a = r.groups[0].self_diagnosis;
+  EXPECT_EQ(a.caught, 2u);
+  EXPECT_EQ(a.missed, 1u);
+  EXPECT_EQ(a.false_alarms, 1u);
+  EXPECT_EQ(a.quiet, 1u);
+  EXPECT_EQ(a.judged(), 5u);
+  EXPECT_NE(selfDiagnosisMarkdown(r).find("| rot | eklt | – | 5 | 2 | 1 | 1 | 1 |"), std::string::npos)
+      << selfDiagnosisMarkdown(r);
+  EXPECT_NE(reportMarkdown(r, "T", {}, {}).find("## Self-diagnosis"), std::string::npos);
+}
+
 TEST(CampaignReport, ComparisonTableHasMediansPerScenarioAndTheirMean) {
   const std::string summary =
       "job_id,scenario,method,sweep,seed,done,status,cause,alignment.describe,paper.mpe_percent,"

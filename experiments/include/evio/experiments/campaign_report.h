@@ -25,6 +25,20 @@ struct Spread {
 /// the finite values.
 Spread spreadOf(std::vector<double> values);
 
+/// The estimator's self-diagnosis (status.yaml degraded or diverged) against
+/// the ground truth's verdict (the divergence bound alone), over the runs
+/// that did not fail and carry both.
+struct SelfDiagnosisAgreement {
+  std::size_t caught = 0;        ///< truth diverged, the estimator flagged it
+  std::size_t missed = 0;        ///< truth diverged, the estimator said ok
+  std::size_t false_alarms = 0;  ///< truth ok, the estimator flagged it
+  std::size_t quiet = 0;         ///< truth ok, the estimator said ok
+
+  std::size_t judged() const { return caught + missed + false_alarms + quiet; }
+  /// Counts one run: estimator_status (ok, degraded, diverged) and truth_diverged ("true"/"false").
+  void count(const std::string& estimator_status, const std::string& truth_diverged);
+};
+
 struct ReportGroup {
   std::string scenario, method, sweep;
   std::size_t runs = 0, ok = 0, diverged = 0, failed = 0, pending = 0;
@@ -39,6 +53,7 @@ struct ReportGroup {
   double anees_lower = 0.0, anees_upper = 0.0;  ///< 95 % bounds for nees_runs runs
   Spread rtf_median;       ///< of the runs' median RTF
   double rtf_max = 0.0;    ///< largest RTF interval of any run
+  SelfDiagnosisAgreement self_diagnosis;
 
   double successRate() const { return runs ? static_cast<double>(ok) / static_cast<double>(runs) : 0.0; }
 };
@@ -59,7 +74,11 @@ CampaignReport aggregateSummary(const std::vector<std::vector<std::string>>& row
 /// row (mean over scenarios of the medians).
 std::string comparisonMarkdown(const CampaignReport& report);
 
-/// The Markdown report: the comparison, a table per scenario, then `figures` (file names
+/// The self-diagnosis table (Markdown, "" when no run carries both verdicts).
+std::string selfDiagnosisMarkdown(const CampaignReport& report);
+
+/// The Markdown report: the comparison, a table per scenario, the
+/// self-diagnosis against the truth, then `figures` (file names
 /// relative to the report) and `notes` (e.g. plots skipped and why).
 std::string reportMarkdown(const CampaignReport& report, const std::string& title,
                            const std::vector<std::string>& figures, const std::vector<std::string>& notes);

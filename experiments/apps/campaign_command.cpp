@@ -129,6 +129,8 @@ void addCampaignCommand(CLI::App& app) {
     options.evio_binary = selfBinary();
     const auto outcomes = experiments::runCampaign(campaign, jobs, options, OutcomePrinter());
     std::printf("task %d: %zu jobs\n", args->task, outcomes.size());
+    for (const auto& o : outcomes)
+      if (o.status == "failed") exitCode() = 3;  // a task with failed jobs did not do what was asked
   });
 
   cmd->callback([cmd, args] {
@@ -193,6 +195,9 @@ void addCampaignCommand(CLI::App& app) {
     std::printf("campaign %s: %zu jobs: %zu ok, %zu diverged, %zu failed, %zu done before; summary: %s\n",
                 campaign.name.c_str(), outcomes.size(), ok, diverged, failed, skipped,
                 (fs::path(results) / "summary.csv").string().c_str());
+    // Exit 3 when any job of the campaign (this run or before) failed.
+    for (const auto& j : jobs)
+      if (!experiments::jobDone(results, j, /*retry_failed=*/true)) exitCode() = 3;
   });
 }
 

@@ -7,6 +7,14 @@
 
 namespace evio::apps {
 
+/// The exit code of a command that ran to its end: 0, or 3 when it ran but
+/// did not do what was asked (an estimate with status failed, a campaign
+/// with failed jobs). Errors are thrown instead (main: 1).
+inline int& exitCode() {
+  static int code = 0;
+  return code;
+}
+
 void addInfoCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);

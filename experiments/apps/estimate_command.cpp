@@ -3,7 +3,8 @@
 // estimator pipeline (estimator/pipeline/pipeline.h) over a sequence folder
 // and writes the estimate folder (trajectory.txt, trajectory_covariance.txt,
 // imu_state.txt, timing.txt, status.yaml, config.yaml, summary.yaml).
-// Divergence is a status in status.yaml (exit code 0); bad input is an error.
+// Divergence is a status in status.yaml (exit code 0); status failed exits 3;
+// bad input is an error (exit 1). The folder is staged and published whole.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "commands.h"
 #include "evio/core/error.h"
 #include "evio/core/io/config.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "progress_line.h"
 
@@ -68,6 +70,7 @@ void addEstimateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "estimate folder to write")->required();
   cmd->add_flag("-q,--quiet", args->quiet, "no progress line or summary");
   cmd->callback([args] {
+    io::requireNotStaging(args->folder);
     config::Document doc =
         args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(resolveConfig(args->config));
     for (const auto& o : args->overrides) config::applyOverride(doc, o);
@@ -92,8 +95,9 @@ void addEstimateCommand(CLI::App& app) {
     estimator::PipelineOptions options = estimator::PipelineOptions::forMethod(args->method);
     config::fill(doc, "", options);
 
+    io::StagedFolder out(args->output);  // published whole at the end, or not at all
     ProgressLine line("estimate", args->method == "eklt-vio" ? "ev" : "s data", args->quiet);
-    const auto result = estimator::runPipeline(args->folder, options, args->output, [&](const auto& p) {
+    const auto result = estimator::runPipeline(args->folder, options, out.path(), [&](const auto& p) {
       char label[96];
       std::snprintf(label, sizeof(label), "estimate %s t=%.2f s%s", args->method.c_str(), nsToSeconds(p.t_ns),
                     p.initialized ? "" : " (not initialised)");
@@ -101,6 +105,14 @@ void addEstimateCommand(CLI::App& app) {
       line.update(p.fraction, args->method == "eklt-vio" ? static_cast<double>(p.events) : nsToSeconds(p.t_ns));
     });
     line.finish();
+    // "ok" with no pose at all (no events, never initialised) is no result.
+    if (result.status.code == io::EstimateStatus::Code::kOk && result.counts.poses == 0)
+      throw Error(args->folder + ": no pose was estimated (" + std::to_string(result.counts.events) + " events, " +
+                  std::to_string(result.counts.frames) + " frames, " + std::to_string(result.counts.imu_samples) +
+                  " IMU samples); nothing written to " + args->output);
+    out.publish();
+    // Divergence is an outcome (exit 0); a failed run did not do what was asked.
+    if (result.status.code == io::EstimateStatus::Code::kFailed) exitCode() = 3;
     if (args->quiet) return;
     const double data_s =
         nsToSeconds(result.t_last_ns - result.initialization_t_ns.value_or(result.t_first_ns));

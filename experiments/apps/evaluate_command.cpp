@@ -13,6 +13,7 @@
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/config.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/experiments/estimate_files.h"
 #include "evio/experiments/metrics_format.h"
 #include "evio/experiments/trajectory_metrics.h"
@@ -81,6 +82,8 @@ void addEvaluateCommand(CLI::App& app) {
       options.alignment.end_s = args->window_s[1];
     }
     options.validate();
+    io::requireNotStaging(args->estimate);
+    io::requireNotStaging(args->groundtruth);
 
     experiments::EstimateFiles files = experiments::findEstimateFiles(args->estimate);
     if (args->no_companions) files = {files.trajectory, "", "", ""};
@@ -106,17 +109,22 @@ void addEvaluateCommand(CLI::App& app) {
 
     if (!args->output.empty()) {
       const fs::path out(args->output);
-      if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
+      if (out.extension() != ".json" && out.extension() != ".csv")
+        throw Error("--output: must end in .json or .csv (got '" + args->output + "')");
+      // The metrics file and its companions are published together (core/io/staged_folder.h).
+      io::StagedFiles staged(args->output);
       if (out.extension() == ".json") {
         const fs::path stem = out.parent_path() / out.stem();
-        io::writeFileAtomic(stem.string() + "_poses.csv", experiments::poseErrorsCsv(metrics));
-        if (metrics.rtf.available) io::writeFileAtomic(stem.string() + "_rtf.csv", experiments::rtfCsv(metrics));
-        io::writeFileAtomic(args->output, json.dump());
-      } else if (out.extension() == ".csv") {
-        io::writeFileAtomic(args->output, experiments::metricsCsv(json));
+        io::writeFileAtomic(staged.path(stem.string() + "_poses.csv"), experiments::poseErrorsCsv(metrics));
+        if (metrics.rtf.available)
+          io::writeFileAtomic(staged.path(stem.string() + "_rtf.csv"), experiments::rtfCsv(metrics));
+        else
+          staged.drop(stem.string() + "_rtf.csv");
+        io::writeFileAtomic(staged.path(args->output), json.dump());
       } else {
-        throw Error("--output: must end in .json or .csv (got '" + args->output + "')");
+        io::writeFileAtomic(staged.path(args->output), experiments::metricsCsv(json));
       }
+      staged.publish();
     }
     if (!args->quiet) std::fputs(experiments::metricsTable(metrics).c_str(), stdout);
   });

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "commands.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/experiments/euroc_export.h"
 
 namespace evio::apps {
@@ -27,7 +28,10 @@ void addExportCommand(CLI::App& app) {
   cmd->add_option("--camera", args->options.camera, "camera of sensors.yaml exported as cam0 (default: the first frame camera)");
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing on success (warnings still go to stderr)");
   cmd->callback([args] {
-    const auto s = experiments::exportEuroc(args->sequence, args->folder, args->options);
+    io::requireNotStaging(args->sequence);
+    io::StagedFolder out(args->folder);  // published whole, or not at all
+    const auto s = experiments::exportEuroc(args->sequence, out.path(), args->options);
+    out.publish();
     for (const auto& w : s.warnings) std::fprintf(stderr, "evio: warning: %s\n", w.c_str());
     if (!args->quiet)
       std::printf("exported %zu frames, %zu IMU samples, %zu ground-truth poses to %s (EuRoC layout, camchain.yaml, "

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "commands.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/experiments/sequence_info.h"
 #include "progress_line.h"
 
@@ -21,6 +22,7 @@ void addInfoCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "no progress line");
   cmd->callback([args] {
     ProgressLine progress("reading events", "ev", args->quiet);
+    io::requireNotStaging(args->folder);
     const auto info = experiments::inspectSequence(args->folder, [&](double fraction, std::uint64_t events) {
       progress.update(fraction, static_cast<double>(events));
     });

@@ -1,13 +1,25 @@
 // The `evio` command-line tool: one executable, one subcommand per job.
-// Errors are printed as one line on stderr with a non-zero exit code.
+// Errors are printed as one line on stderr with a non-zero exit code
+// (README: exit codes): 0 done, 1 error (nothing published), 2 internal
+// error, 3 ran but the result failed, 100-199 usage, 130/143 interrupted.
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include "commands.h"
 #include "evio/core/error.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/core/version.h"
 
+namespace {
+int finish(int code) {
+  evio::io::writeFaultCount();
+  return code;
+}
+}  // namespace
+
 int main(int argc, char** argv) {
+  evio::io::installInterruptHandlers();
   CLI::App app{"evio: event-camera visual-inertial odometry test bench (simulate, estimate, evaluate)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", evio::evioVersion());
@@ -26,13 +38,21 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return finish(app.exit(e));
   } catch (const evio::Error& e) {
     std::fprintf(stderr, "evio: error: %s\n", e.what());
-    return 1;
+    return finish(1);
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path of the wrong kind, a symlink loop, a permission: name the path.
+    const std::string where = !e.path1().empty() ? e.path1().string() : "filesystem";
+    std::fprintf(stderr, "evio: error: %s: %s\n", where.c_str(), e.code().message().c_str());
+    return finish(1);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "evio: error: out of memory\n");
+    return finish(1);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "evio: internal error: %s\n", e.what());
-    return 2;
+    return finish(2);
   }
-  return 0;
+  return finish(evio::apps::exitCode());
 }

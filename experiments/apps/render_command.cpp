@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "evio/core/error.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/simulator/render_job.h"
 
 namespace evio::apps {
@@ -68,13 +69,19 @@ void addRenderCommand(CLI::App& app) {
       const auto v = numbers(args->velocity, 6, "--velocity");
       job.velocity = simulator::CameraVelocity{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
     }
+    const std::string target = job.out_dir;
+    io::StagedFolder out(target);  // published whole at the end, or not at all
+    job.out_dir = out.path();
     const auto report = simulator::runRenderJob(job);
+    out.publish();
+    job.out_dir = target;
     if (args->quiet) return;
     std::printf("scene: %zu triangles, %zu vertices; build %.3f s (generate %.3f, BVH %.3f, indirect %.3f)\n",
                 report.stats.triangles, report.stats.vertices, report.stats.total_s(), report.stats.generate_s,
                 report.stats.bvh_s, report.stats.indirect_s);
     std::printf("render: %.3f s\n", report.render_s);
-    for (const auto& f : report.files) std::printf("wrote %s\n", f.c_str());
+    for (const auto& f : report.files)
+      std::printf("wrote %s\n", f.rfind(out.path(), 0) == 0 ? (target + f.substr(out.path().size())).c_str() : f.c_str());
   });
 }
 

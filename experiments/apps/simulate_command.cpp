@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/simulator/sequence_simulator.h"
 #include "progress_line.h"
 
@@ -37,15 +38,17 @@ void addSimulateCommand(CLI::App& app) {
     std::vector<std::string> overrides = args->overrides;
     if (args->threads >= 0) overrides.push_back("threads=" + std::to_string(args->threads));
     const simulator::Scenario scenario = simulator::loadScenario(args->scenario, overrides, EVIO_SOURCE_DIR);
+    io::StagedFolder out(args->folder);  // published whole at the end, or not at all
     ProgressLine line("simulate", "ev", args->quiet);
     const auto stats = simulator::simulateSequence(
-        scenario, args->folder, [&line](const simulator::SimulationProgress& p) {
+        scenario, out.path(), [&line](const simulator::SimulationProgress& p) {
           char label[96];
           std::snprintf(label, sizeof(label), "simulate %.2f/%.2f s sim, %llu renders", p.simulated_s, p.total_s,
                         static_cast<unsigned long long>(p.renders));
           line.setLabel(label);
           line.update(p.total_s > 0 ? p.simulated_s / p.total_s : 1.0, static_cast<double>(p.events));
         });
+    out.publish();
     line.finish();
     if (args->quiet) return;
     std::printf("simulated %.3f s in %.1f s wall (%.3f x real time; scene build %.1f s)\n", stats.simulated_s,

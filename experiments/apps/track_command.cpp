@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/config.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/core/io/tracks_txt.h"
 #include "evio/experiments/track_sequence.h"
 #include "progress_line.h"
@@ -37,6 +38,8 @@ void addTrackCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "tracks file to write (id t x y)")->required();
   cmd->add_flag("-q,--quiet", args->quiet, "no progress line or summary");
   cmd->callback([args] {
+    io::requireNotStaging(args->folder);
+    io::checkOutputFile(args->output);
     config::Document doc = args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(args->config);
     for (const auto& o : args->overrides) config::applyOverride(doc, o);
     if (!args->frontend.empty()) config::applyOverride(doc, "tracker=" + args->frontend);
@@ -49,10 +52,12 @@ void addTrackCommand(CLI::App& app) {
       progress.update(fraction, static_cast<double>(events));
     });
     progress.finish();
-    io::writeTracksText(args->output, result.samples,
+    io::StagedFiles staged(args->output);  // the tracks and their .yaml published together
+    io::writeTracksText(staged.path(args->output), result.samples,
                         {"evio track " + args->folder + " (" + options.tracker + ", " + options.image_source + ")",
                          "pixels of camera " + result.camera_name, "id t x y"});
-    io::writeFileAtomic(args->output + ".yaml", config::toYaml(options));
+    io::writeFileAtomic(staged.path(args->output + ".yaml"), config::toYaml(options));
+    staged.publish();
     if (!args->quiet)
       std::printf("%llu tracks, %zu samples; %llu events (%llu after filters), %llu frames; %.2f s in the frontend "
                   "(%.0f events/s)\n",

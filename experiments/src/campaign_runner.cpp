@@ -20,6 +20,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/core/stopwatch.h"
 #include "evio/experiments/child_process.h"
 #include "evio/experiments/json_value.h"
@@ -155,6 +156,7 @@ std::string ensureSequence(const Campaign& c, const Job& job, const RunnerOption
   const fs::path tmp = final_dir.string() + ".tmp." + hostName() + "." + ctx.unique();
   fs::create_directories(final_dir.parent_path());
   fs::remove_all(tmp);
+  const io::InterruptCleanup cleanup(tmp.string());  // removed on SIGINT/SIGTERM
   auto vars = vars_in;
   vars["sequence"] = tmp.string();
   StepRecord rec{"simulate", expandCommand(c, c.simulate, vars, job), "", 0.0};
@@ -219,6 +221,7 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
   const fs::path final_dir = results / "jobs" / job.id;
   const fs::path staging = results / "staging" / (job.id + "." + hostName() + "." + ctx.unique());
   fs::remove_all(staging);
+  io::InterruptCleanup cleanup(staging.string());  // removed on SIGINT/SIGTERM
   fs::create_directories(staging / "logs");
 
   std::map<std::string, std::string> vars;
@@ -258,7 +261,11 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
     rec.result = r.describe();
     rec.wall_s = r.wall_s;
     steps.push_back(rec);
-    if (!r.ok()) {
+    // `evio estimate` exits 3 after writing an estimate whose status is
+    // failed: the evaluate step still scores it (the job's status: failed).
+    const bool failed_estimate = std::string(name) == "estimate" && r.started && !r.timed_out && r.signal == 0 &&
+                                 r.exit_code == 3 && fs::is_regular_file(staging / "estimate" / "status.yaml");
+    if (!r.ok() && !failed_estimate) {
       const std::string last = lastLineOf(log);
       failed_step = name;
       cause = std::string(name) + ": " + r.describe() + (last.empty() ? "" : ": " + last);
@@ -287,9 +294,12 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
   outcome.wall_s = watch.seconds();
   io::writeFileAtomic((staging / "job.yaml").string(),
                       jobYaml(c, job, vars["sequence"], outcome, steps, started));
-  if (o.retry_failed && fs::exists(final_dir)) fs::remove_all(final_dir);
   fs::create_directories(final_dir.parent_path());
-  publish(staging, final_dir);
+  if (o.retry_failed && fs::exists(final_dir))
+    io::publishFolder(staging.string(), final_dir.string());  // the failed job replaced whole, never mixed
+  else
+    publish(staging, final_dir);
+  cleanup.release();
   return outcome;
 }
 

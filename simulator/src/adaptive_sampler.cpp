@@ -9,8 +9,8 @@ namespace evio::simulator {
 
 void AdaptiveSampler::Options::validate() const {
   requireInRange("lambda", lambda, 1e-3, 10.0);
-  requirePositive("min_rate_hz", min_rate_hz);
-  requirePositive("max_rate_hz", max_rate_hz);
+  requireInRange("min_rate_hz", min_rate_hz, 1e-3, 1e5);
+  requireInRange("max_rate_hz", max_rate_hz, 1e-3, 1e5);
   requireField(max_rate_hz >= min_rate_hz, "max_rate_hz", "must be >= min_rate_hz");
   requireInRange("tile_px", tile_px, 1, 1024);
 }

@@ -89,8 +89,8 @@ void RigOptions::validate() const {
 
 void RenderScheduleOptions::validate() const {
   requireInRange("lambda", lambda, 1e-3, 10.0);
-  requirePositive("min_rate_hz", min_rate_hz);
-  requirePositive("max_rate_hz", max_rate_hz);
+  requireInRange("min_rate_hz", min_rate_hz, 1e-3, 1e5);  // a bound on the render count, not physics
+  requireInRange("max_rate_hz", max_rate_hz, 1e-3, 1e5);
   requireField(max_rate_hz >= min_rate_hz, "max_rate_hz", "must be >= min_rate_hz");
   requireField(fastest_pixel_quantile > 0.0 && fastest_pixel_quantile <= 1.0, "fastest_pixel_quantile",
                "must be in (0, 1]");
@@ -105,8 +105,9 @@ void SequenceOutputOptions::validate() const {
 }
 
 void ScenarioOptions::validate() const {
-  requireNonNegative("start_s", start_s);
+  requireInRange("start_s", start_s, 0.0, 1e6);  // times become int64 ns: far below 9.2e9 s
   requirePositive("duration_s", duration_s);
+  requireInRange("duration_s", duration_s, 0.0, 1e6);
   requireInRange("threads", threads, 0, 1024);
   validateIn("rig", rig);
   validateIn("sampling", sampling);

@@ -2,9 +2,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+
+#include "evio/core/error.h"
+#include "evio/core/io/atomic_file.h"
 
 namespace evio::config {
 
@@ -21,11 +25,12 @@ std::vector<std::string> splitPath(const std::string& path) {
 }  // namespace
 
 Document loadFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw Error::inFile(path, 0, "not a configuration file (a folder?)");
   std::ifstream in(path);
   if (!in) throw Error::inFile(path, 0, "cannot open configuration file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return loadString(text.str(), path);
+  return loadString(io::readFile(path, 64u << 20), path);
 }
 
 Document loadString(const std::string& text, const std::string& name) {

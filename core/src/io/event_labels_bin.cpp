@@ -60,7 +60,7 @@ void EventLabelWriter::close() {
 }
 
 std::vector<std::uint8_t> readEventLabels(const std::string& path) {
-  const std::string raw = readFile(path);
+  const std::string raw = readFile(path, static_cast<std::size_t>(-1));  // one byte per event: no cap
   if (raw.size() < kHeaderBytes || std::memcmp(raw.data(), kMagic, 8) != 0)
     throw Error::inFile(path, 0, "not an event label file (magic EVIOLBL1 missing)");
   std::uint64_t n = 0;

@@ -407,9 +407,9 @@ void appendLe(std::string& out, T v) {
 
 }  // namespace
 
-TriangleMesh readObj(const std::string& path) { return parseObj(path, readFile(path)); }
+TriangleMesh readObj(const std::string& path) { return parseObj(path, readFile(path, static_cast<std::size_t>(-1))); }
 
-TriangleMesh readPly(const std::string& path) { return parsePly(path, readFile(path)); }
+TriangleMesh readPly(const std::string& path) { return parsePly(path, readFile(path, static_cast<std::size_t>(-1))); }
 
 TriangleMesh readMesh(const std::string& path) {
   const std::string ext = extensionOf(path);

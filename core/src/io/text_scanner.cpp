@@ -58,6 +58,9 @@ bool LineReader::next(std::string_view& line) {
       ++line_number_;
       return true;
     }
+    if (end_ - begin_ > kMaxLineBytes)
+      throw Error::inFile(path_, line_number_ + 1,
+                          "line longer than " + std::to_string(kMaxLineBytes) + " bytes (not a text table?)");
     if (!refill()) {
       if (begin_ == end_) return false;
       // Last line without a newline.
@@ -170,6 +173,9 @@ bool parseSecondsToNs(std::string_view text, TimeNs* t_ns) {
     *t_ns = static_cast<TimeNs>(std::llround(ns));
     return true;
   }
+  // seconds * 1e9 + frac_ns must fit int64 (|t| < 9.223372036e9 s).
+  if (seconds > std::numeric_limits<std::int64_t>::max() / kNsPerSecond) return false;
+  if (frac_ns > std::numeric_limits<std::int64_t>::max() - seconds * kNsPerSecond) return false;
   const TimeNs total = seconds * kNsPerSecond + frac_ns;
   *t_ns = negative ? -total : total;
   return true;

@@ -8,6 +8,8 @@
 #include <string>
 #include <string_view>
 
+#include "evio/core/io/staged_folder.h"
+
 namespace evio::io {
 
 /// A file being written. `commit()` flushes, closes and renames the temporary
@@ -31,6 +33,7 @@ class AtomicFile {
   std::string path_;
   std::string tmp_path_;
   std::FILE* file_ = nullptr;
+  InterruptCleanup cleanup_;  ///< the temporary is removed on SIGINT/SIGTERM
 };
 
 /// Writes `content` to `path` atomically.
@@ -43,7 +46,8 @@ std::string temporaryPathFor(const std::string& path);
 /// Renames `from` onto `to` (atomic on one file system); throws on failure.
 void renameFile(const std::string& from, const std::string& to);
 
-/// Reads a whole (small) text file; throws Error naming the file when missing.
-std::string readFile(const std::string& path);
+/// Reads a whole (small) text file; throws Error naming the file when missing,
+/// not a regular file, or larger than `max_bytes`.
+std::string readFile(const std::string& path, std::size_t max_bytes = 256u << 20);
 
 }  // namespace evio::io

@@ -25,6 +25,9 @@ class LineReader {
   LineReader(const LineReader&) = delete;
   LineReader& operator=(const LineReader&) = delete;
 
+  /// Longest line accepted; a longer one is an error naming file and line.
+  static constexpr std::size_t kMaxLineBytes = 1u << 20;
+
   /// Next line without its end-of-line ("\n" or "\r\n"); false at the end.
   /// The view stays valid until the next call.
   bool next(std::string_view& line);

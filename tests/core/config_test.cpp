@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <limits>
+
 #include "evio/core/eigen_types.h"
 #include "evio/core/io/atomic_file.h"
 #include "temp_dir.h"
@@ -141,6 +144,40 @@ TEST(Config, DefaultsRoundTripThroughYaml) {
   EXPECT_EQ(a.exposure_s, b.exposure_s);
   b.inner.count = 99;
   EXPECT_FALSE(config::equal(a, b));
+}
+
+TEST(Config, NumbersAreWrittenSoEveryYamlReaderTakesThemForNumbers) {
+  EXPECT_EQ(config::yamlNumber(10.0), "10");
+  EXPECT_EQ(config::yamlNumber(90.0), "90");
+  EXPECT_EQ(config::yamlNumber(2e4), "20000");
+  EXPECT_EQ(config::yamlNumber(-0.0), "0");
+  EXPECT_EQ(config::yamlNumber(0.25), "0.25");
+  EXPECT_EQ(config::yamlNumber(1e-5), "1.0e-05");
+  EXPECT_EQ(config::yamlNumber(2.5e-7), "2.5e-07");
+  EXPECT_EQ(config::yamlNumber(1e20), "1.0e+20");
+  EXPECT_EQ(config::yamlNumber(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(config::yamlNumber(-std::numeric_limits<double>::infinity()), "-.inf");
+  EXPECT_EQ(config::yamlNumber(std::numeric_limits<double>::quiet_NaN()), ".nan");
+  // Each reads back exactly (yaml-cpp), and PyYAML (YAML 1.1, Debian's
+  // python3-yaml) parses every written number as an int or a float.
+  OuterOptions a;
+  a.exposure_s = 10.0;
+  a.weights = {1e-5, 90.0, 2e4, 1e20, 0.1 + 0.2, 2.5e-7};
+  a.offset_m = Vec3(1e-12, -3.0, 1e16);
+  const std::string text = config::toYaml(a);
+  OuterOptions b;
+  config::fill(doc(text), "", b);
+  EXPECT_TRUE(config::equal(a, b)) << text;
+  test::TempDir dir;
+  io::writeFileAtomic(dir.file("numbers.yaml"), text);
+  const std::string check =
+      "/usr/bin/python3 -c \"import sys, yaml\n"
+      "d = yaml.safe_load(open(sys.argv[1]))\n"
+      "nums = [d['exposure_s'], d['inner']['threshold_pos']] + d['weights'] + d['offset_m']\n"
+      "bad = [x for x in nums if not isinstance(x, (int, float))]\n"
+      "sys.exit(1 if bad else 0)\" " +
+      dir.file("numbers.yaml");
+  EXPECT_EQ(std::system(check.c_str()), 0) << text;
 }
 
 TEST(Config, SyntaxErrorAndMissingFile) {

@@ -1,6 +1,7 @@
 #include "evio/core/io/config.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -200,25 +201,31 @@ std::string scalarAs<std::string>(const Document& doc, const YAML::Node& node,
   return node.Scalar();
 }
 
-void emitDouble(YAML::Emitter& out, double v) {
-  if (std::isinf(v)) {
-    out << (v > 0 ? ".inf" : "-.inf");
-    return;
+std::string yamlNumber(double v) {
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  // Whole numbers as integers ("10", not "1e+01", which YAML 1.1 readers
+  // such as PyYAML take for a string).
+  if (v == std::floor(v) && std::fabs(v) < 1e15) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.0f", v);
+    return std::string(buf) == "-0" ? "0" : buf;
   }
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  // Keep it readable: use the shortest representation that round-trips.
+  // Else the shortest representation that round-trips, with a '.' in the
+  // mantissa whenever there is an exponent ("1.0e-05", not "1e-05").
+  std::string text;
   for (int p = 1; p <= 17; ++p) {
     std::ostringstream t;
     t.precision(p);
     t << v;
-    if (std::stod(t.str()) == v) {
-      out << t.str();
-      return;
-    }
+    text = t.str();
+    if (std::stod(text) == v) break;
   }
-  out << s.str();
+  const std::size_t e = text.find('e');
+  if (e != std::string::npos && text.find('.') == std::string::npos) text.insert(e, ".0");
+  return text;
 }
+
+void emitDouble(YAML::Emitter& out, double v) { out << yamlNumber(v); }
 
 }  // namespace evio::config

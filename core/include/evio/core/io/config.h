@@ -69,8 +69,14 @@ template <> std::string scalarAs<std::string>(const Document&, const YAML::Node&
 template <class T>
 void readValue(const Document& doc, const YAML::Node& node, const std::string& path, T& out);
 
-/// Writes a double with the shortest text that reads back to the same value
-/// (.inf/-.inf for infinities).
+/// A double as YAML text that reads back to the same value and that every
+/// YAML reader (1.1 and 1.2: yaml-cpp, PyYAML, OpenCV) takes for a number:
+/// whole numbers below 1e15 as integers ("10"), others the shortest
+/// round-trip text with a '.' in any mantissa ("0.25", "1.0e-05"), and
+/// .inf, -.inf, .nan.
+std::string yamlNumber(double v);
+
+/// Writes yamlNumber(v).
 void emitDouble(YAML::Emitter& out, double v);
 
 /// Writes fields() of an Options struct (or any value readValue reads) into

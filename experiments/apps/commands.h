@@ -8,6 +8,7 @@
 namespace evio::apps {
 
 void addInfoCommand(CLI::App& app);
+void addStatsCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addTrackCommand(CLI::App& app);

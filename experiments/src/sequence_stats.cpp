@@ -2,6 +2,7 @@
 #include "evio/experiments/sequence_stats.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <opencv2/core.hpp>
 
@@ -67,7 +68,9 @@ std::string exposureNote(const std::string& folder, bool has_sensors_yaml) {
   std::string note = "not recorded per frame; sensors.yaml configures";
   for (const char* key : {"auto_exposure", "exposure_s"}) {
     const auto it = cam->parameters.find(key);
-    if (it != cam->parameters.end()) note += std::string(" ") + key + " = " + std::to_string(it->second);
+    char value[32];
+    std::snprintf(value, sizeof(value), "%g", it == cam->parameters.end() ? 0.0 : it->second);
+    if (it != cam->parameters.end()) note += std::string(" ") + key + " = " + value;
   }
   return note + " (the setting, before auto-exposure or first-frame metering)";
 }

@@ -16,6 +16,7 @@ inline int& exitCode() {
 }
 
 void addInfoCommand(CLI::App& app);
+void addStatsCommand(CLI::App& app);
 void addTrajectoryCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addTrackCommand(CLI::App& app);

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", evio::evioVersion());
   evio::apps::addInfoCommand(app);
+  evio::apps::addStatsCommand(app);
   evio::apps::addTrajectoryCommand(app);
   evio::apps::addRenderCommand(app);
   evio::apps::addTrackCommand(app);

@@ -13,6 +13,7 @@
 #include "evio/core/io/imu_txt.h"
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/stopwatch.h"
+#include "evio/experiments/sequence_info.h"
 
 namespace evio::experiments {
 
@@ -23,7 +24,8 @@ namespace fs = std::filesystem;
 /// Events in time order from events.h5 or events.txt, handed out up to a time.
 class EventSource {
  public:
-  explicit EventSource(const std::string& folder) {
+  /// `required`: a folder without events is an error (else it gives no events).
+  EventSource(const std::string& folder, bool required) {
     const fs::path h5 = fs::path(folder) / "events.h5";
     const fs::path txt = fs::path(folder) / "events.txt";
     if (fs::exists(h5)) {
@@ -32,7 +34,7 @@ class EventSource {
     } else if (fs::exists(txt)) {
       txt_ = std::make_unique<io::EventTextReader>(txt.string());
       total_ = static_cast<std::uint64_t>(fs::file_size(txt) / 24);  // ~bytes per line, for progress only
-    } else {
+    } else if (required) {
       throw Error(folder + ": no events.h5 or events.txt");
     }
   }
@@ -44,6 +46,7 @@ class EventSource {
     if (pos_ >= buffer_.size()) {
       buffer_.clear();
       pos_ = 0;
+      if (!h5_ && !txt_) return false;  // a frames-only folder (KLT)
       const bool more = h5_ ? h5_->next(buffer_, max) : txt_->next(buffer_, max);
       if (!more) return false;
       read_ += buffer_.size();
@@ -91,10 +94,23 @@ CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
   }
   const fs::path calib = fs::path(folder) / "calib.txt";
   if (!fs::exists(calib)) throw Error(folder + ": neither sensors.yaml nor calib.txt");
-  if (images.empty()) throw Error(folder + ": calib.txt gives no resolution and there are no frames");
-  const cv::Mat first = io::readFrame(folder, images.front());
-  return CameraChoice{io::cameraFromCalibTxt(io::readCalibTxt(calib.string()), first.cols, first.rows), std::nullopt,
-                      "calib.txt"};
+  // calib.txt has no sensor size: the first frame's, else the events' (as `evio info`).
+  int width = 0, height = 0;
+  std::string size_from;
+  if (!images.empty()) {
+    const cv::Mat first = io::readFrame(folder, images.front());
+    width = first.cols;
+    height = first.rows;
+  } else {
+    const SequenceInfo info = inspectSequence(folder);
+    if (info.width <= 0)
+      throw Error(folder + ": calib.txt gives no resolution, and there are neither frames nor events to take it from");
+    width = info.width;
+    height = info.height;
+    size_from = " (size from " + info.resolution_source + ")";
+  }
+  return CameraChoice{io::cameraFromCalibTxt(io::readCalibTxt(calib.string()), width, height), std::nullopt,
+                      "calib.txt" + size_from};
 }
 
 }  // namespace
@@ -115,7 +131,8 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   }
 
   estimator::Frontend frontend(options, cam.camera, cam.T_B_C);
-  EventSource events(folder);
+  // KLT tracks on frames alone: a frames-only folder has no events to read.
+  EventSource events(folder, /*required=*/options.tracker != "klt");
   TrackSequenceResult result;
   result.camera_name = cam.name;
   std::unordered_map<std::int64_t, TimeNs> last_t;

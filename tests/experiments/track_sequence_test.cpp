@@ -100,5 +100,34 @@ TEST(TrackSequence, MissingInputsAreErrors) {
   EXPECT_THROW(trackSequence(dir.path().string(), {}), Error);  // no frames, no events
 }
 
+TEST(TrackSequence, RunsOnTheRealSlicesAsTheyAre) {
+  // tests/data/ecd (Event-Camera Dataset, Mueggler et al. 2017): an
+  // events-only folder with calib.txt (no sensor size: taken from the
+  // events, 240x180) and a frames-only folder. No hand-made sensors.yaml.
+  const std::string root = std::string(EVIO_SOURCE_DIR) + "/tests/data/ecd/";
+  estimator::FrontendOptions eklt;
+  eklt.tracker = "eklt";
+  eklt.image_source = "reconstructed";
+  const TrackSequenceResult e = trackSequence(root + "shapes_rotation_events", eklt);
+  EXPECT_EQ(e.events, 50879u);  // every line of events.txt
+  EXPECT_EQ(e.frames, 0u);
+  EXPECT_NE(e.camera_name.find("events (max x, y + 1)"), std::string::npos) << e.camera_name;
+  EXPECT_GT(e.tracks, 0u);
+  estimator::FrontendOptions klt;
+  klt.tracker = "klt";
+  const TrackSequenceResult k = trackSequence(root + "boxes_6dof_frames", klt);
+  EXPECT_EQ(k.frames, 60u);
+  EXPECT_EQ(k.events, 0u);
+  EXPECT_GT(k.tracks, 0u);
+  // EKLT on the frames-only folder still needs its events: one clear error.
+  eklt.image_source = "frames";
+  try {
+    trackSequence(root + "boxes_6dof_frames", eklt);
+    ADD_FAILURE() << "EKLT ran without events";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("no events.h5 or events.txt"), std::string::npos) << err.what();
+  }
+}
+
 }  // namespace
 }  // namespace evio::experiments

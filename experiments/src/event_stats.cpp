@@ -1,6 +1,7 @@
 // EventStatsAccumulator: the event half of `evio stats` (sequence_stats.h).
 #include <algorithm>
 #include <limits>
+#include <string>
 
 #include "evio/core/error.h"
 #include "evio/experiments/sequence_stats.h"
@@ -38,6 +39,13 @@ void EventStatsAccumulator::Impl::addOne(TimeNs t, int x, int y, bool on) {
   ++s.count;
   s.on_count += on ? 1 : 0;
   const auto window = static_cast<std::size_t>((t - s.t_first_ns) / window_ns);
+  // The rate series grows with the time span: bound it (a stray timestamp
+  // far in the future must be an error, not gigabytes of empty windows).
+  constexpr std::size_t kMaxWindows = 100'000'000;
+  if (window >= kMaxWindows)
+    throw Error("events: " + std::to_string(window) + " rate windows of " + std::to_string(window_ns) +
+                " ns from the first event at an event of " + std::to_string(nsToSeconds(t)) +
+                " s; give a wider rate_window_s or check the timestamps");
   if (window >= s.window_counts.size()) s.window_counts.resize(window + 1, 0);
   ++s.window_counts[window];
 

@@ -18,7 +18,8 @@ namespace evio::experiments {
 namespace fs = std::filesystem;
 
 void SequenceStatsOptions::validate() const {
-  requirePositive("rate_window_s", rate_window_s);
+  // At least 1 µs (windows are whole nanoseconds), at most an hour.
+  requireField(rate_window_s >= 1e-6 && rate_window_s <= 3600.0, "rate_window_s", "must be in [1e-6, 3600] s");
   requirePositive("burst_gap_s", burst_gap_s);
   requireNonNegative("isolation_window_s", isolation_window_s);
   requireField(width_px >= 0 && height_px >= 0, "width_px", "must be >= 0 (0: from the folder)");

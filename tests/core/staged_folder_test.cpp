@@ -1,6 +1,7 @@
 // Outputs as transactions (core/io/staged_folder.h) and the bounds on hostile
 // text input (line length, seconds that overflow int64 nanoseconds).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -58,12 +59,31 @@ TEST(StagedFolder, UnpublishedLeavesNothingAndTheOldOutputStays) {
 TEST(StagedFolder, StaleStagingOfADeadProcessIsRemovedAndAHalfPublishedOldRestored) {
   const fs::path dir = scratch("stale");
   const std::string target = (dir / "out").string();
-  fs::create_directories(target + ".staging.999999999");  // no such process
-  fs::create_directories(target + ".old.999999999");
-  writeFileAtomic(target + ".old.999999999/a.txt", "previous");
+  const pid_t child = ::fork();  // a PID of this system whose process has ended
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);
+  const std::string dead = std::to_string(child);
+  fs::create_directories(target + ".staging." + dead);
+  fs::create_directories(target + ".old." + dead);
+  writeFileAtomic(target + ".old." + dead + "/a.txt", "previous");
+  // Not ours: a number no PID can have (a user's dated backup), and names of other shapes.
+  fs::create_directories(target + ".old.20240101999");
+  writeFileAtomic(target + ".tmp.123", "a user's file");
   EXPECT_EQ(removeStaleStaging(target), 2u);
-  EXPECT_FALSE(fs::exists(target + ".staging.999999999"));
+  EXPECT_FALSE(fs::exists(target + ".staging." + dead));
   EXPECT_EQ(readFile(target + "/a.txt"), "previous");
+  EXPECT_TRUE(fs::exists(target + ".old.20240101999"));
+  EXPECT_TRUE(fs::exists(target + ".tmp.123"));
+  fs::remove_all(dir);
+}
+
+TEST(StagedFolder, ASymbolicLinkAsTheOutputFolderIsRefusedUpFront) {
+  const fs::path dir = scratch("link");
+  fs::create_directories(dir / "real");
+  fs::create_directory_symlink(dir / "real", dir / "link");
+  EXPECT_THROW(checkOutputFolder((dir / "link").string()), Error);
+  EXPECT_NO_THROW(checkOutputFolder((dir / "real").string()));
   fs::remove_all(dir);
 }
 

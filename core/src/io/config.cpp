@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -219,7 +220,7 @@ std::string yamlNumber(double v) {
     t.precision(p);
     t << v;
     text = t.str();
-    if (std::stod(text) == v) break;
+    if (std::strtod(text.c_str(), nullptr) == v) break;  // strtod: no exception for subnormals
   }
   const std::size_t e = text.find('e');
   if (e != std::string::npos && text.find('.') == std::string::npos) text.insert(e, ".0");

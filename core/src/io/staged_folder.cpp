@@ -76,6 +76,19 @@ bool allDigits(const std::string& s) {
   return true;
 }
 
+/// The largest PID of this system (/proc/sys/kernel/pid_max; 4194304 when unreadable).
+long maxPid() {
+  static const long max = [] {
+    long v = 4194304;
+    if (std::FILE* f = std::fopen("/proc/sys/kernel/pid_max", "r")) {
+      if (std::fscanf(f, "%ld", &v) != 1) v = 4194304;
+      std::fclose(f);
+    }
+    return v;
+  }();
+  return max;
+}
+
 bool processAlive(long pid) { return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
 
 std::string errnoText(int e) { return std::error_code(e, std::generic_category()).message(); }
@@ -197,9 +210,12 @@ void checkParents(const std::string& target) {
 void checkOutputFolder(const std::string& target) {
   if (target.empty()) throw Error("output folder: empty path");
   std::error_code ec;
-  const fs::file_status st = fs::status(target, ec);
+  const fs::file_status st = fs::symlink_status(target, ec);
   if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
     throw Error(target + ": " + ec.message());
+  // Publication replaces the folder itself (an atomic exchange), never through a link.
+  if (fs::is_symlink(st))
+    throw Error(target + ": is a symbolic link; give the output folder's own path (output folder)");
   if (fs::exists(st) && !fs::is_directory(st)) throw Error(target + ": exists and is not a folder (output folder)");
   checkParents(target);
 }
@@ -233,11 +249,14 @@ std::size_t removeStaleStaging(const std::string& target) {
     bool old = false;
     if (rest.rfind("staging.", 0) == 0) pid_text = rest.substr(8);
     else if (rest.rfind("old.", 0) == 0) pid_text = rest.substr(4), old = true;
-    else if (rest.rfind("tmp.", 0) == 0) pid_text = rest.substr(4, rest.find('.', 4) == std::string::npos
-                                                                       ? std::string::npos
-                                                                       : rest.find('.', 4) - 4);
+    else if (rest.rfind("tmp.", 0) == 0) {  // AtomicFile's "tmp.<pid>.<n>" exactly
+      const std::size_t dot = rest.find('.', 4);
+      if (dot != std::string::npos && allDigits(rest.substr(dot + 1))) pid_text = rest.substr(4, dot - 4);
+    }
     if (!allDigits(pid_text) || pid_text.size() > 12) continue;
-    if (processAlive(std::strtol(pid_text.c_str(), nullptr, 10))) continue;
+    const long pid = std::strtol(pid_text.c_str(), nullptr, 10);
+    // Not a PID of this system (e.g. a user's "out.old.20240101"): not ours.
+    if (pid > maxPid() || processAlive(pid)) continue;
     std::error_code rec;
     if (old && !fs::exists(t, rec)) {
       fs::rename(e.path(), t, rec);  // a publication killed half-way: the previous output returns
@@ -277,7 +296,9 @@ void publishFolder(const std::string& staging, const std::string& target) {
   faultPoint(target);
   if (std::rename(staging.c_str(), target.c_str()) != 0) {
     const int e = errno;
-    std::rename(old.c_str(), target.c_str());
+    if (std::rename(old.c_str(), target.c_str()) != 0)
+      throw Error(target + ": cannot publish the output (rename from " + staging + "): " + errnoText(e) +
+                  "; the previous output is in " + old);
     throw Error(target + ": cannot publish the output (rename from " + staging + "): " + errnoText(e));
   }
   std::error_code ec;

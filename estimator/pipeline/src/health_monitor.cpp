@@ -3,6 +3,7 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 
 namespace evio::estimator {
 
@@ -21,8 +22,13 @@ HealthMonitor::HealthMonitor(const HealthOptions& options)
 io::HealthRow healthRow(const Estimate& e) {
   const InnovationStats& n = e.innovation;
   const double var_p = e.cov_pose_B.diagonal().head<3>().maxCoeff();
+  // A covariance that is no longer finite (the update that makes the filter
+  // diverge) is reported as the largest σ a file can hold, so that the
+  // monitor flags it and health.txt stays readable.
+  const double sigma_p =
+      std::isfinite(var_p) ? std::sqrt(std::max(var_p, 0.0)) : std::numeric_limits<double>::max();
   return io::HealthRow{e.t_ns, n.nis, n.dof, n.accepted, n.rejected, e.num_slam_features, e.num_msckf_features,
-                       std::sqrt(std::max(var_p, 0.0))};
+                       sigma_p};
 }
 
 void HealthMonitor::process(Estimate& in, std::vector<Estimate>& out) {

@@ -13,6 +13,7 @@
 #include "evio/core/io/imu_txt.h"
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/stopwatch.h"
+#include "evio/estimator/frontend/event_prefilter.h"
 #include "evio/experiments/sequence_info.h"
 
 namespace evio::experiments {
@@ -131,6 +132,12 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   }
 
   estimator::Frontend frontend(options, cam.camera, cam.T_B_C);
+  // The pre-filters run before the tracker, as in the pipeline's PrefilterStage.
+  std::unique_ptr<estimator::EventPrefilter> prefilter;
+  if (!options.prefilter.passThrough())
+    prefilter = std::make_unique<estimator::EventPrefilter>(options.prefilter, cam.camera.width(), cam.camera.height());
+  EventArray filtered;
+  std::uint64_t events_seen = 0;
   // KLT tracks on frames alone: a frames-only folder has no events to read.
   EventSource events(folder, /*required=*/options.tracker != "klt");
   TrackSequenceResult result;
@@ -164,7 +171,12 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   const auto feedEventsUntil = [&](std::optional<TimeNs> t_end) {
     while (events.next(chunk, t_end)) {
       feedImuUntil(chunk.t().back());
-      run([&] { frontend.addEvents(chunk); });
+      events_seen += chunk.size();
+      run([&] {
+        if (!prefilter) return frontend.addEvents(chunk);
+        prefilter->filter(chunk, 0, chunk.size(), &filtered);
+        frontend.addEvents(filtered);
+      });
       collect();
       if (progress) progress(events.fraction(), events.read());
     }
@@ -178,8 +190,8 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
     ++result.frames;
   }
   feedEventsUntil(std::nullopt);
-  result.events = frontend.numEventsSeen();
-  result.events_kept = frontend.numEventsKept();
+  result.events = events_seen;
+  result.events_kept = frontend.numEvents();
   result.reconstructed_frames = frontend.numReconstructedFrames();
   result.tracks = last_t.size();
   result.processing_s = busy;

@@ -17,11 +17,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-std::string timeText(TimeNs t_ns) { return std::to_string(nsToSeconds(t_ns)) + " s"; }
-
-}  // namespace
-
-namespace {
 /// σ_z in normalised image coordinates: σ_img_px / mean focal length (px),
 /// unless given directly.
 double normalizedImageSigma(const BackendOptions& options, const Camera& camera) {
@@ -114,8 +109,8 @@ void Backend::addImu(const ImuSample& in) {
   if (!status_.ok()) return;
   if (have_last_imu_) {
     if (in.t_ns < last_imu_.t_ns)
-      throw Error("Backend::addImu: reading at " + timeText(in.t_ns) + " is older than the previous one at " +
-                  timeText(last_imu_.t_ns));
+      throw Error("Backend::addImu: reading at " + secondsText(in.t_ns, 6) + " is older than the previous one at " +
+                  secondsText(last_imu_.t_ns, 6));
     if (in.t_ns == last_imu_.t_ns) {
       ++stats_.imu_duplicates_dropped;
       return;
@@ -133,7 +128,7 @@ void Backend::addImu(const ImuSample& in) {
     if (gap_s > options_.imu_max_gap_s) ++stats_.imu_gaps;
     if (gap_s > options_.imu_fail_gap_s && initialized_) {
       setStatus(BackendStatus::Code::kFailed, "IMU gap of " + std::to_string(gap_s) + " s before " +
-                                                  timeText(s.t_ns));
+                                                  secondsText(s.t_ns, 6));
       return;
     }
   }
@@ -163,8 +158,8 @@ void Backend::enqueue(TimeNs t_imu_ns, Item item) {
 namespace {
 void requireOrdered(TimeNs* last, TimeNs t_ns, const char* what) {
   if (t_ns < *last)
-    throw Error(std::string("Backend: ") + what + " at " + timeText(t_ns) + " is older than the previous one at " +
-                timeText(*last));
+    throw Error(std::string("Backend: ") + what + " at " + secondsText(t_ns, 6) + " is older than the previous one at " +
+                secondsText(*last, 6));
   *last = t_ns;
 }
 }  // namespace

@@ -22,8 +22,6 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
     tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C);
   else
     tracker_ = std::make_unique<KltTracker>(options_.klt, camera);
-  if (!options_.prefilter.passThrough())
-    prefilter_ = std::make_unique<EventPrefilter>(options_.prefilter, camera.width(), camera.height());
   if (options_.image_source == "reconstructed")
     reconstructor_ = std::make_unique<ImageReconstructor>(options_.reconstruction, camera.width(), camera.height());
 }
@@ -31,17 +29,7 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
 Frontend::~Frontend() = default;
 
 void Frontend::addEvents(const EventArray& events) {
-  events_seen_ += events.size();
-  if (prefilter_) {
-    prefilter_->filter(events, 0, events.size(), &filtered_);
-    track(filtered_);
-  } else {
-    track(events);
-  }
-}
-
-void Frontend::track(const EventArray& events) {
-  events_kept_ += events.size();
+  events_ += events.size();
   if (!reconstructor_) {
     tracker_->addEvents(events, 0, events.size());
     return;

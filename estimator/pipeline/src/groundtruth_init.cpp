@@ -1,7 +1,6 @@
 #include "evio/estimator/pipeline/groundtruth_init.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <utility>
 
 #include "evio/core/error.h"
@@ -9,24 +8,11 @@
 
 namespace evio::estimator {
 
-namespace {
-
-std::string secondsText(TimeNs t_ns) { return std::to_string(nsToSeconds(t_ns)) + " s"; }
-
-/// "1.234 s": seconds to the millisecond.
-std::string millisecondText(TimeNs t_ns) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3f s", nsToSeconds(t_ns));
-  return buf;
-}
-
-}  // namespace
-
 Pose interpolatePose(const Trajectory& T_W_C, TimeNs t_ns) {
   require(!T_W_C.empty(), "ground truth: no poses");
   if (t_ns < T_W_C.front().t_ns || t_ns > T_W_C.back().t_ns)
-    throw Error("ground truth: time " + secondsText(t_ns) + " outside its span [" + secondsText(T_W_C.front().t_ns) +
-                ", " + secondsText(T_W_C.back().t_ns) + "]");
+    throw Error("ground truth: time " + secondsText(t_ns, 6) + " outside its span [" +
+                secondsText(T_W_C.front().t_ns, 6) + ", " + secondsText(T_W_C.back().t_ns, 6) + "]");
   const auto it = firstPoseAtOrAfter(T_W_C, t_ns);
   if (it->t_ns == t_ns) return it->pose;
   // Position linear, rotation by slerp (core/pose.h); the initial attitude is
@@ -44,7 +30,7 @@ ImuState initialStateFromTrajectory(const Trajectory& T_W_C, TimeNs t_cam_ns, co
   const TimeNs ta = std::max(T_W_C.front().t_ns, t_cam_ns - h);
   const TimeNs tb = std::min(T_W_C.back().t_ns, t_cam_ns + h);
   if (tb <= ta)
-    throw Error("ground truth: no span around " + secondsText(t_cam_ns) + " to take the initial velocity from");
+    throw Error("ground truth: no span around " + secondsText(t_cam_ns, 6) + " to take the initial velocity from");
   const Vec3 pa = (interpolatePose(T_W_C, ta) * T_C_B).translation();
   const Vec3 pb = (interpolatePose(T_W_C, tb) * T_C_B).translation();
   ImuState x;
@@ -74,8 +60,8 @@ std::optional<ImuState> GroundTruthInitializer::offer(TimeNs t_imu_ns) {
   if (t_cam_ns < *t_init_cam_ns_) return std::nullopt;
   const Trajectory gt = readTrajectoryPrefix(path_, *t_init_cam_ns_ + secondsToNs(half_window_s_));
   if (gt.back().t_ns < *t_init_cam_ns_)
-    throw Error(path_ + ": ends at " + millisecondText(gt.back().t_ns) + ", before the initialisation time " +
-                millisecondText(*t_init_cam_ns_));
+    throw Error(path_ + ": ends at " + secondsText(gt.back().t_ns) + ", before the initialisation time " +
+                secondsText(*t_init_cam_ns_));
   return initialStateFromTrajectory(gt, *t_init_cam_ns_, T_B_C_, half_window_s_, offset_ns_);
 }
 
@@ -85,7 +71,7 @@ Trajectory readTrajectoryPrefix(const std::string& path, TimeNs t_until_ns) {
   StampedPose p;
   while (reader.next(p)) {
     if (!out.empty() && p.t_ns <= out.back().t_ns)
-      throw Error(path + ": time does not increase at " + secondsText(p.t_ns));
+      throw Error(path + ": time does not increase at " + secondsText(p.t_ns, 6));
     out.push_back(p);
     if (p.t_ns > t_until_ns) break;
   }

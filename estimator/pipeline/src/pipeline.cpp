@@ -19,12 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string secondsText(TimeNs t_ns) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3f s", nsToSeconds(t_ns));
-  return buf;
-}
-
 /// Adds the wall time of its lifetime to a counter.
 class StageTimer {
  public:

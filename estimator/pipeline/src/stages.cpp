@@ -25,15 +25,8 @@ void PrefilterStage::process(SequenceItem& in, std::vector<SequenceItem>& out) {
 
 // --- FrontendStage -------------------------------------------------------------------
 
-namespace {
-FrontendOptions withoutPrefilter(FrontendOptions options) {
-  options.prefilter = EventPrefilterOptions{};
-  return options;
-}
-}  // namespace
-
 FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera)
-    : frontend_(withoutPrefilter(options), camera.camera, camera.T_B_C) {}
+    : frontend_(options, camera.camera, camera.T_B_C) {}
 
 void FrontendStage::process(SequenceItem& in, std::vector<FrontendOutput>& out) {
   FrontendOutput& o = out.emplace_back();

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 
 namespace evio {
 
@@ -19,5 +21,12 @@ inline TimeNs secondsToNs(double t_s) { return static_cast<TimeNs>(std::llround(
 
 /// Nanoseconds to seconds (double).
 constexpr double nsToSeconds(TimeNs t_ns) { return static_cast<double>(t_ns) * 1e-9; }
+
+/// A time for messages: "12.345 s" (`decimals` digits after the point).
+inline std::string secondsText(TimeNs t_ns, int decimals = 3) {
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "%.*f s", decimals, nsToSeconds(t_ns));
+  return buf;
+}
 
 }  // namespace evio

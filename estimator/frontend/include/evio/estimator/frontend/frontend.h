@@ -1,9 +1,10 @@
 #pragma once
 /// @file frontend.h
-/// The frontend as the pipelines and `evio track` use it: event pre-filters,
-/// an optional event-based image reconstruction, and one tracker (EKLT or
-/// KLT) behind the FeatureTracker interface. Inputs in time order
-/// (feature_tracker.h).
+/// The frontend as the pipelines and `evio track` use it: an optional
+/// event-based image reconstruction and one tracker (EKLT or KLT) behind the
+/// FeatureTracker interface. Inputs in time order (feature_tracker.h). The
+/// event pre-filters (event_prefilter.h, options `prefilter`) run before it:
+/// the pipeline's PrefilterStage, or the caller.
 
 #include <memory>
 #include <optional>
@@ -22,7 +23,7 @@ namespace evio::estimator {
 struct FrontendOptions {
   std::string tracker = "eklt";          ///< eklt | klt
   std::string image_source = "frames";   ///< frames | reconstructed (from events)
-  EventPrefilterOptions prefilter;
+  EventPrefilterOptions prefilter;  ///< for the pre-filter that runs before the frontend
   EkltOptions eklt;
   KltOptions klt;
   ImageReconstructorOptions reconstruction;
@@ -46,7 +47,7 @@ class Frontend {
   Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
   ~Frontend();
 
-  /// Events (non-decreasing time): pre-filtered, integrated into the
+  /// Events (non-decreasing time, already pre-filtered): integrated into the
   /// reconstruction (which may emit frames in between), then tracked.
   void addEvents(const EventArray& events);
   /// A sensor frame (CV_8UC1): to the tracker (image_source frames) or fused
@@ -58,19 +59,15 @@ class Frontend {
   FeatureTracker& tracker() { return *tracker_; }
   const FeatureTracker& tracker() const { return *tracker_; }
 
-  std::uint64_t numEventsSeen() const { return events_seen_; }
-  std::uint64_t numEventsKept() const { return events_kept_; }
+  /// Events given to addEvents().
+  std::uint64_t numEvents() const { return events_; }
   std::uint64_t numReconstructedFrames() const { return reconstructed_frames_; }
 
  private:
-  void track(const EventArray& events);
   FrontendOptions options_;
   std::unique_ptr<FeatureTracker> tracker_;
-  std::unique_ptr<EventPrefilter> prefilter_;
   std::unique_ptr<ImageReconstructor> reconstructor_;
-  EventArray filtered_;
-  std::uint64_t events_seen_ = 0;
-  std::uint64_t events_kept_ = 0;
+  std::uint64_t events_ = 0;
   std::uint64_t reconstructed_frames_ = 0;
 };
 

@@ -62,7 +62,6 @@ class PrefilterStage : public Stage<SequenceItem, SequenceItem> {
 /// frames in, track points out; IMU samples feed its gyro prediction.
 class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
  public:
-  /// `options.prefilter` is ignored: the PrefilterStage runs before.
   FrontendStage(const FrontendOptions& options, const CameraSensor& camera);
   void process(SequenceItem& in, std::vector<FrontendOutput>& out) override;
   std::uint64_t numFrames() const { return frames_; }

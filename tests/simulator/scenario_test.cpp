@@ -102,8 +102,14 @@ rig:
   EXPECT_NE(e.find("duration_s"), std::string::npos) << e;
   e = load("duration_s: 100\n");  // the hover preset lasts 60 s
   EXPECT_NE(e.find("past the end of the trajectory"), std::string::npos) << e;
-  e = load("  frame_camera: {rate_hz: 20, sensor: {auto_exposure_max_s: 0.1}}\n");
-  EXPECT_NE(e.find("auto_exposure_max_s"), std::string::npos) << e;
+  e = load("  frame_camera: {rate_hz: 20, sensor: {auto_exposure: false, exposure_s: 0.04, readout_s: 0.02}}\n");
+  EXPECT_NE(e.find("sensor.exposure_s"), std::string::npos) << e;
+  e = load("  frame_camera: {preset: simulator/presets/aps_davis240c.yaml, rate_hz: 24}\n");  // 5 + 41 ms > 1/24 s
+  EXPECT_NE(e.find("sensor.exposure_s"), std::string::npos) << e;
+  e = load("  frame_camera: {preset: simulator/presets/aps_davis240c.yaml, sensor: {shutter: diagonal}}\n");
+  EXPECT_NE(e.find("shutter"), std::string::npos) << e;
+  e = load("  frame_camera: {preset: simulator/presets/no_such_aps.yaml}\n");
+  EXPECT_NE(e.find("no_such_aps.yaml"), std::string::npos) << e;
   e = errorOf([&] {
     loadScenarioString(base + "  range_finder: {enabled: true, T_B_L: [1,0,0,0, 0,1,0,0, 0,0,2,0, 0,0,0,1]}\n",
                        "bad.yaml", "", {}, EVIO_SOURCE_DIR);

@@ -6,6 +6,7 @@
 // against exposure, and frames independent of the thread count.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -186,6 +187,52 @@ TEST(ApsModel, RollingShutterRowsIntegrateTheirOwnWindow) {
   const Frame g = global.capture(0, gs);
   const double expected = per_radiance * scale * (l0 + alpha * 0.001);
   for (int y = 0; y < h; ++y) EXPECT_NEAR(g.image.at<std::uint8_t>(y, 0), expected, 0.5 + 1e-6);
+}
+
+TEST(ApsModel, RollingShutterSkewsAMovingEdgeByTheRowTime) {
+  // A vertical edge moving right at v = 2000 px/s, bright (L_b) on its left:
+  // the pixel centre x is bright from t_x = (x − x0) / v on. Row y exposes
+  // [y t_row, y t_row + t_exp], so its bright fraction is
+  // clamp((y t_row + t_exp − t_x) / t_exp, 0, 1): the edge in row y lies
+  // v · t_row = 1 px further right than in row y − 1. Renders every 50 µs;
+  // the interpolation between two renders blurs the crossing by at most
+  // half a render interval, 2.5 % of the exposure, 3.2 DN at L_b's 128 DN.
+  const int w = 64, h = 16;
+  const double t_row = 0.0005, t_exp = 0.002, v = 2000.0, x0 = 10.25;  // crossings between pixel centres
+  FrameCamera::Options o = noiseless(preset("aps_legacy.yaml"));
+  o.auto_exposure = false;
+  o.exposure_s = t_exp;
+  o.readout_s = t_row * h;
+  o.shutter = "rolling";
+  FrameCamera cam(w, h, o, 1);
+  const double span = cam.frameSpanS(t_exp);  // 9.5 ms
+  const double bright_dn = 128.0;
+  const auto l_b = static_cast<float>(bright_dn / 255.0 * o.full_well_e / (cam.electronsPerRadianceSecond() * t_exp));
+  std::vector<cv::Mat> samples;
+  const int n = static_cast<int>(std::lround(span / 50e-6)) + 1;
+  for (int j = 0; j < n; ++j) {
+    const double t = span * j / (n - 1);
+    cv::Mat m(h, w, CV_32FC1, cv::Scalar(0.0f));
+    for (int x = 0; x < w; ++x)
+      if (x < x0 + v * t) m.col(x).setTo(cv::Scalar(l_b));
+    samples.push_back(m);
+  }
+  const Frame f = cam.capture(0, samples);
+  double worst = 0.0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double t_x = (x - x0) / v;
+      const double fraction = std::clamp((y * t_row + t_exp - t_x) / t_exp, 0.0, 1.0);
+      worst = std::max(worst, std::abs(f.image.at<std::uint8_t>(y, x) - bright_dn * fraction));
+    }
+  EXPECT_LT(worst, 3.2 + 0.5);  // interpolation bound plus rounding
+  // The edge (first pixel below half brightness) moves 1 px per row.
+  const auto edge = [&](int y) {
+    int x = 0;
+    while (x < w && f.image.at<std::uint8_t>(y, x) >= bright_dn / 2) ++x;
+    return x;
+  };
+  for (int y = 1; y < h; ++y) EXPECT_EQ(edge(y) - edge(y - 1), 1) << y;
 }
 
 TEST(ApsModel, FixedExposureStaysWhateverTheScene) {

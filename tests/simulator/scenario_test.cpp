@@ -130,6 +130,33 @@ rig:
   EXPECT_FALSE(e.empty());
 }
 
+TEST(Scenario, FrameCameraPresetLiesUnderTheScenariosKeys) {
+  const std::string text = R"(
+scene: scenes/presets/ec_shapes.yaml
+trajectory: trajectories/presets/hover.yaml
+rig:
+  event_camera: {preset: simulator/presets/davis240c.yaml}
+  frame_camera:
+    preset: simulator/presets/aps_davis240c.yaml
+    rate_hz: 20
+    sensor: {exposure_s: 0.003}
+)";
+  const Scenario s = loadScenarioString(text, "s.yaml", "", {"rig.frame_camera.sensor.shutter=rolling"}, EVIO_SOURCE_DIR);
+  const auto& sensor = s.options.rig.frame_camera.sensor;
+  EXPECT_EQ(sensor.exposure_s, 0.003);       // the scenario's key
+  EXPECT_EQ(sensor.shutter, "rolling");      // the override
+  EXPECT_EQ(sensor.full_well_e, 10350.0);    // the preset's
+  EXPECT_EQ(sensor.dark_offset_dn, -16.7);
+  EXPECT_FALSE(sensor.auto_exposure);
+  // The resolved scenario holds every sensor key inline and no preset.
+  const std::string yaml = s.resolvedYaml();
+  EXPECT_NE(yaml.find("saturation_dn: 131.3"), std::string::npos);
+  const Scenario again = loadScenarioString(yaml, "resolved.yaml", "", {}, EVIO_SOURCE_DIR);
+  EXPECT_EQ(again.options.rig.frame_camera.sensor.full_well_e, 10350.0);
+  EXPECT_EQ(again.options.rig.frame_camera.sensor.shutter, "rolling");
+  EXPECT_TRUE(again.options.rig.frame_camera.preset.empty());
+}
+
 TEST(Scenario, InlineSectionsNeedNoPresetFiles) {
   const char* text = R"(
 duration_s: 1

@@ -45,9 +45,8 @@ def main(folder):
     white = a >= 108
     vals = np.where(white, a, np.nan)
     keep = white.sum(0) >= 30
-    with np.errstate(all="ignore"):
-        mu = np.nanmean(vals, 0)[keep]
-        sd = np.nanstd(vals, 0, ddof=1)[keep]
+    mu = np.nanmean(vals[:, keep], 0)
+    sd = np.nanstd(vals[:, keep], 0, ddof=1)
     print(f"white level {a[white].mean():.2f} DN (pixels >= 108)")
     print(f"white FPN sigma {mu.std():.2f} DN over {keep.sum()} pixels; white temporal sigma {np.sqrt(np.mean(sd**2)):.2f} DN")
     means, diffs = [], []
@@ -67,12 +66,17 @@ def main(folder):
             xs.append(m[s].mean())
             ys.append(d[s].var() / 2)
     g, s0 = np.polyfit(xs, ys, 1)
-    print(f"photon transfer: {len(means)} still pairs, {len(m)} pixels; var = {g:.4f} * DN + {s0:.3f}")
-    print(f"  gain {g:.4f} DN/e-  ({1 / g:.1f} e-/DN); read noise {np.sqrt(max(s0 - 1 / 12, 0)):.2f} DN")
     zero = (a == 0).mean()
     density = np.mean([(a == v).mean() for v in range(1, 9)])
+    offset = -zero / density
+    white = a[white].mean()
+    # Shot noise grows with the signal above the offset: var = g (DN - offset) + read^2 + 1/12.
+    read = np.sqrt(max(s0 - 1 / 12 + g * offset, 0))
+    print(f"photon transfer: {len(means)} still pairs, {len(m)} pixels; var = {g:.4f} * DN + {s0:.3f}")
     print(f"black pile {100 * zero:.2f} % at 0 DN; density {100 * density:.3f} %/DN over 1-8 DN; "
-          f"implied dark offset {-zero / density:.1f} DN")
+          f"implied dark offset {offset:.1f} DN")
+    print(f"gain {g:.4f} DN/e- ({1 / g:.1f} e-/DN); swing {white - offset:.1f} DN = full well {(white - offset) / g:.0f} e-; "
+          f"read noise {read:.2f} DN = {read / g:.0f} e-")
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <numbers>
 #include <string>
 
@@ -17,6 +18,8 @@
 #include "evio/core/io/config.h"
 #include "evio/simulator/davis_auto_exposure.h"
 #include "evio/simulator/frame_camera.h"
+#include "evio/simulator/scenario.h"
+#include "temp_dir.h"
 
 namespace evio::simulator {
 namespace {
@@ -372,6 +375,31 @@ TEST(ApsModel, RejectsOptionsOutOfRange) {
   o = preset("aps_davis240c.yaml");
   o.fill_factor = 1.5;
   EXPECT_THROW(o.validate(), Error);
+}
+
+TEST(ApsModel, ABadPresetFileIsNamedWithItsLineAndField) {
+  const test::TempDir dir;
+  const auto errorWith = [&](const std::string& preset_text) {
+    std::ofstream(dir.file("aps.yaml")) << preset_text;
+    const std::string scenario = "scene: scenes/presets/ec_shapes.yaml\n"
+                                 "trajectory: trajectories/presets/hover.yaml\n"
+                                 "rig:\n"
+                                 "  event_camera: {preset: simulator/presets/davis240c.yaml}\n"
+                                 "  frame_camera: {preset: " + dir.file("aps.yaml") + "}\n";
+    try {
+      loadScenarioString(scenario, "s.yaml", "", {}, EVIO_SOURCE_DIR);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string e = errorWith("exposure_s: 0.005\nfull_wel_e: 10000\n");
+  EXPECT_NE(e.find("aps.yaml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("full_wel_e"), std::string::npos) << e;
+  e = errorWith("exposure_s: 0.005\nfill_factor: 2\n");
+  EXPECT_NE(e.find("fill_factor"), std::string::npos) << e;
+  e = errorWith("shutter: [global]\n");
+  EXPECT_NE(e.find("aps.yaml:1"), std::string::npos) << e;
 }
 
 }  // namespace

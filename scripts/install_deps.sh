@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libceres-dev libopencv-dev libembree-dev libtbb-dev
   libopenexr-dev libyaml-cpp-dev libhdf5-dev libcli11-dev libgdal-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
-  python3 python3-matplotlib python3-numpy python3-yaml
+  python3 python3-matplotlib python3-numpy python3-yaml python3-pil
   slurm-wlm munge
 )
 

@@ -13,7 +13,7 @@
 ///   trajectory: <path> | {preset: <path>, <keys replaced>} | {<inline trajectory>}
 ///   rig:
 ///     event_camera: {preset: <simulator/presets/*.yaml>, <EventCameraRigOptions keys>}
-///     frame_camera: {...}       # FrameCameraRigOptions
+///     frame_camera: {preset: <simulator/presets/aps_*.yaml>, sensor: {...}, ...}  # FrameCameraRigOptions
 ///     imu: {...}                # ImuSimulator::Options, Kalibr names
 ///     range_finder: {...}       # RangeFinderRigOptions
 ///   sampling: {...}             # RenderScheduleOptions
@@ -23,7 +23,8 @@
 /// `search_root` (the repository, so `scenes/presets/mars_yard.yaml` works
 /// from anywhere). A `{preset: ...}` map loads the preset and replaces the
 /// keys given beside `preset` (event_camera: merged key by key, nested maps
-/// included; lists are replaced whole). Unknown keys are an error naming the
+/// included; lists are replaced whole; frame_camera: the preset fills
+/// `sensor`, under the keys of `sensor:`). Unknown keys are an error naming the
 /// file and line; `--set` overrides (`rig.imu.update_rate_hz=200`,
 /// `trajectory.center_m=[0,0,2]`, `duration_s=2`) apply before resolving.
 ///

@@ -9,6 +9,7 @@ packages=(
   libopenexr-dev libyaml-cpp-dev libhdf5-dev libcli11-dev libgdal-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3 python3-matplotlib python3-numpy python3-yaml python3-pil
+  dpkg-dev binutils
   slurm-wlm munge
 )
 

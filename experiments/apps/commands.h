@@ -28,5 +28,10 @@ void addExportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addEstimateCommand(CLI::App& app);
 void addHealthCommand(CLI::App& app);
+void addVideoCommand(CLI::App& app);
+
+/// Every subcommand above, in the order `evio --help` lists them (main.cpp;
+/// the command-line fuzzer, tests/fuzz/fuzz_cli.cpp).
+void addAllCommands(CLI::App& app);
 
 }  // namespace evio::apps

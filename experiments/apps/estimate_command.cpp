@@ -16,26 +16,10 @@
 #include "evio/core/io/config.h"
 #include "evio/core/io/staged_folder.h"
 #include "evio/estimator/pipeline/pipeline.h"
+#include "data_root.h"
 #include "progress_line.h"
 
-#ifndef EVIO_SOURCE_DIR
-#define EVIO_SOURCE_DIR ""
-#endif
-
 namespace evio::apps {
-
-namespace {
-
-/// A config path as given, else relative to the source tree (estimator/config/…).
-std::string resolveConfig(const std::string& path) {
-  namespace fs = std::filesystem;
-  if (fs::exists(path) || fs::path(path).is_absolute()) return path;
-  const fs::path in_tree = fs::path(EVIO_SOURCE_DIR) / path;
-  if (!std::string(EVIO_SOURCE_DIR).empty() && fs::exists(in_tree)) return in_tree.string();
-  return path;
-}
-
-}  // namespace
 
 void addEstimateCommand(CLI::App& app) {
   struct Args {
@@ -72,7 +56,7 @@ void addEstimateCommand(CLI::App& app) {
   cmd->callback([args] {
     io::requireNotStaging(args->folder);
     config::Document doc =
-        args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(resolveConfig(args->config));
+        args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(resolveDataPath(args->config));
     for (const auto& o : args->overrides) config::applyOverride(doc, o);
     // --method wins; else the configuration's `method` (campaign methods set
     // it with --set, e.g. an eklt-vio variant on reconstructed frames).

@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   evio::apps::addCampaignCommand(app);
   evio::apps::addReportCommand(app);
   evio::apps::addExportCommand(app);
+  evio::apps::addImportCommand(app);
   evio::apps::addSimulateCommand(app);
   evio::apps::addEstimateCommand(app);
   evio::apps::addHealthCommand(app);

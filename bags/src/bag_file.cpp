@@ -6,6 +6,7 @@
 
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <new>
 
 #include "evio/core/error.h"
@@ -21,6 +22,18 @@ namespace {
 /// "<bag>: <context>: <message>", leaving out an empty context.
 Error bagError(const std::string& bag, const std::string& context, const std::string& message) {
   return Error(bag + ": " + (context.empty() ? "" : context + ": ") + message);
+}
+
+/// The first line of a ROS 1 bag is "#ROSBAG V2.0" (version 1.2 and older are
+/// another format that librosbag_storage reads only partly).
+void requireBagVersion2(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char line[13] = {};
+  in.read(line, sizeof(line));
+  const std::string first(line, static_cast<std::size_t>(in.gcount()));
+  if (first.rfind("#ROSBAG V", 0) != 0) throw Error(path + ": not a ROS 1 bag (it does not start with #ROSBAG V2.0)");
+  if (first != "#ROSBAG V2.0\n")
+    throw Error(path + ": ROS bag version '" + first.substr(9, first.find('\n') - 9) + "': only version 2.0 is read");
 }
 
 }  // namespace
@@ -54,6 +67,7 @@ void openForReading(rosbag::Bag& bag, const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error(path + ": no such file");
   if (!fs::is_regular_file(path, ec)) throw Error(path + ": not a regular file");
+  requireBagVersion2(path);
   try {
     bag.open(path, rosbag::bagmode::Read);
   } catch (...) {

@@ -11,7 +11,7 @@ packages=(
   python3 python3-matplotlib python3-numpy python3-yaml
   librosbag-storage-dev libroscpp-core-dev libsensor-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
   python3-rosbag python3-roslz4 python3-genpy python3-genmsg python3-sensor-msgs python3-geometry-msgs
-  python3-std-msgs python3-pil
+  python3-std-msgs python3-pil time
   slurm-wlm munge
 )
 

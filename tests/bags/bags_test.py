@@ -389,6 +389,42 @@ class ExportReadByRosbag(unittest.TestCase):
         for name in names:
             self.assertTrue(filecmp.cmp(os.path.join(self.seq, name), os.path.join(out, name), shallow=False), name)
 
+    def test_imported_sequence_estimates_as_the_original(self):
+        bag = self.export("none", "estimate.bag")
+        out = os.path.join(self.dir, "imported_for_estimate")
+        shutil.rmtree(out, ignore_errors=True)
+        self.assertEqual(run("import", bag, "-o", out, "-q").returncode, 0)
+        trajectories = []
+        for seq in (self.seq, out):
+            est = seq + "_estimate"
+            r = run("estimate", seq, "--method", "klt-vio", "--init", "groundtruth", "-o", est, "-q")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(os.path.join(est, "trajectory.txt")) as f:
+                trajectories.append([line for line in f if not line.startswith("#")])  # the header names the folder
+        self.assertGreater(len(trajectories[0]), 1)
+        self.assertEqual(trajectories[0], trajectories[1])
+
+    def test_real_slices_round_trip(self):
+        for name in ("shapes_rotation_events", "boxes_6dof_frames"):
+            with self.subTest(slice=name):
+                src = os.path.join(REPO, "tests/data/ecd", name)
+                bag = os.path.join(self.dir, name + ".bag")
+                out = os.path.join(self.dir, name)
+                shutil.rmtree(out, ignore_errors=True)
+                self.assertEqual(run("export", src, "--format", "rosbag", "-o", bag, "-q").returncode, 0)
+                self.assertEqual(run("import", bag, "-o", out, "-q").returncode, 0)
+                for f in os.listdir(src):
+                    if f in ("calib.txt", "images") or f.endswith(".md"):
+                        continue
+                    self.assertTrue(filecmp.cmp(os.path.join(src, f), os.path.join(out, f), shallow=False), f)
+                if os.path.isdir(os.path.join(src, "images")):
+                    for f in os.listdir(os.path.join(src, "images")):
+                        self.assertTrue(filecmp.cmp(os.path.join(src, "images", f), os.path.join(out, "images", f),
+                                                    shallow=False), f)
+                # The same numbers, written in their shortest form (0.0 becomes 0).
+                self.assertEqual([float(v) for v in read_rows(os.path.join(src, "calib.txt"))[0]],
+                                 [float(v) for v in read_rows(os.path.join(out, "calib.txt"))[0]])
+
     def test_export_is_deterministic(self):
         a = self.export("bz2", "a.bag")
         b = self.export("bz2", "b.bag")

@@ -155,6 +155,9 @@ BagExportSummary exportBag(const std::string& sequence, const std::string& bag_p
   const bool has_events = fs::exists(inFolder(sequence, "events.txt")) || fs::exists(inFolder(sequence, "events.h5"));
   const EventCamera cam = eventCamera(sequence, rig, has_events);
   auto sources = openSources(sequence, cam, options, has_events);
+  if (sources.empty() && !rig && !cam.calib)
+    throw Error(sequence + ": nothing to export (no events, images.txt, imu.txt, groundtruth.txt, calib.txt or "
+                "sensors.yaml)");
 
   BagExportSummary summary;
   summary.width = cam.width;

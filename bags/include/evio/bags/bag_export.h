@@ -6,8 +6,9 @@
 ///   /dvs/camera_info    sensor_msgs/CameraInfo  one message: calib.txt (else the
 ///                                               event camera of sensors.yaml) at the sensor size
 ///   /evio/sensors_yaml  std_msgs/String         one message: sensors.yaml verbatim (when present)
-///   /dvs/events         dvs_msgs/EventArray     the events of each `event_window_s`
-///                                               (at most `max_events_per_message`)
+///   /dvs/events         dvs_msgs/EventArray     consecutive events: a message spans less
+///                                               than `event_window_s` from its first event
+///                                               and holds at most `max_events_per_message`
 ///   /dvs/image_raw      sensor_msgs/Image       each frame, mono8
 ///   /dvs/imu            sensor_msgs/Imu         each sample (no orientation)
 ///   /groundtruth/pose   geometry_msgs/PoseStamped  each ground-truth pose (T_W_E)
@@ -31,7 +32,7 @@ namespace evio::bags {
 struct BagExportOptions {
   /// Chunk compression: "none", "bz2" or "lz4".
   std::string compression = "none";
-  /// Time span of one EventArray message, s; in [1e-6, 1].
+  /// An EventArray message holds events with t - t_first < event_window_s; s, in [1e-6, 1].
   double event_window_s = 0.001;
   /// Most events in one EventArray message; in [1, 10^7].
   std::uint64_t max_events_per_message = 100'000;

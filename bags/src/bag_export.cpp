@@ -1,5 +1,6 @@
 #include "evio/bags/bag_export.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -135,11 +136,15 @@ struct TemporaryBag {
 
 void BagExportOptions::validate() const {
   if (compression != "none" && compression != "bz2" && compression != "lz4")
-    throw Error("compression: '" + compression + "' is not none, bz2 or lz4");
-  if (!(event_window_s >= 1e-6 && event_window_s <= 1.0))
-    throw Error("event_window_s: " + std::to_string(event_window_s) + " is outside [1e-6, 1] s");
+    throw Error("compression (--compression): '" + compression + "' is not none, bz2 or lz4");
+  if (!(event_window_s >= 1e-6 && event_window_s <= 1.0)) {
+    char text[64];
+    std::snprintf(text, sizeof(text), "%g", event_window_s);
+    throw Error("event_window_s (--event-window): " + std::string(text) + " s is outside [1e-6, 1] s");
+  }
   if (max_events_per_message < 1 || max_events_per_message > 10'000'000)
-    throw Error("max_events_per_message: " + std::to_string(max_events_per_message) + " is outside [1, 10^7]");
+    throw Error("max_events_per_message (--max-events-per-message): " + std::to_string(max_events_per_message) +
+                " is outside [1, 10^7]");
 }
 
 BagExportSummary exportBag(const std::string& sequence, const std::string& bag_path, const BagExportOptions& options) {

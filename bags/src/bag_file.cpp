@@ -19,9 +19,14 @@ void silenceRosLogging() { console_bridge::setLogLevel(console_bridge::CONSOLE_B
 
 namespace {
 
-/// "<bag>: <context>: <message>", leaving out an empty context.
+/// "<bag>: <context>: <message>", leaving out an empty context. Control
+/// characters (a damaged bag's topic name may hold a newline) become '?',
+/// so the error stays one line.
 Error bagError(const std::string& bag, const std::string& context, const std::string& message) {
-  return Error(bag + ": " + (context.empty() ? "" : context + ": ") + message);
+  std::string text = bag + ": " + (context.empty() ? "" : context + ": ") + message;
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return Error(text);
 }
 
 /// The first line of a ROS 1 bag is "#ROSBAG V2.0" (version 1.2 and older are

@@ -9,6 +9,7 @@
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/calib_txt.h"
+#include "evio/core/io/events_h5.h"
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/images_txt.h"
 #include "evio/core/io/imu_txt.h"
@@ -89,14 +90,16 @@ std::map<TopicKind, std::string> chooseTopics(const std::map<std::string, TopicT
 /// is created with its first message.
 class SequenceSink {
  public:
-  SequenceSink(std::string folder, BagImportSummary& summary) : folder_(std::move(folder)), summary_(summary) {}
+  SequenceSink(std::string folder, std::string events_format, BagImportSummary& summary)
+      : folder_(std::move(folder)), events_format_(std::move(events_format)), summary_(summary) {}
 
   void events(const RosEventArray& msg) {
     checkSensorSize(msg.width, msg.height, "EventArray");
-    if (!events_) events_ = std::make_unique<io::EventTextWriter>(file("events.txt"));
+    if (!events_ && !events_h5_) openEventWriters();
     chunk_.clear();
     detail::appendEvents(msg, chunk_, last_event_t_ns_);
-    events_->append(chunk_);
+    if (events_) events_->append(chunk_);
+    if (events_h5_) events_h5_->append(chunk_);
     summary_.events += chunk_.size();
     ++summary_.event_messages;
   }
@@ -151,6 +154,7 @@ class SequenceSink {
 
   void close() {
     if (events_) events_->close();
+    if (events_h5_) events_h5_->close();
     if (frames_) frames_->close();
     if (imu_) imu_->close();
     if (poses_) poses_->close();
@@ -160,6 +164,18 @@ class SequenceSink {
   std::string file(const char* name) {
     summary_.files.emplace_back(name);
     return (fs::path(folder_) / name).string();
+  }
+
+  /// events.txt and/or events.h5; the latter with the sensor size known so far
+  /// (from the first EventArray, or a CameraInfo before it) as attributes.
+  void openEventWriters() {
+    if (events_format_ != "h5") events_ = std::make_unique<io::EventTextWriter>(file("events.txt"));
+    if (events_format_ != "txt") {
+      io::EventH5Options h5;
+      h5.width = summary_.width;
+      h5.height = summary_.height;
+      events_h5_ = std::make_unique<io::EventH5Writer>(file("events.h5"), h5);
+    }
   }
 
   /// Sensor sizes of EventArray and CameraInfo must agree (0 = not given).
@@ -184,8 +200,10 @@ class SequenceSink {
   }
 
   std::string folder_;
+  std::string events_format_;
   BagImportSummary& summary_;
   std::unique_ptr<io::EventTextWriter> events_;
+  std::unique_ptr<io::EventH5Writer> events_h5_;
   std::unique_ptr<io::ImageFolderWriter> frames_;
   std::unique_ptr<io::ImuTextWriter> imu_;
   std::unique_ptr<io::TumWriter> poses_;
@@ -218,7 +236,13 @@ void dispatch(TopicKind kind, const rosbag::MessageInstance& m, SequenceSink& si
 
 }  // namespace
 
+void BagImportOptions::validate() const {
+  if (events_format != "txt" && events_format != "h5" && events_format != "both")
+    throw Error("events_format (--events): '" + events_format + "' is not txt, h5 or both");
+}
+
 BagImportSummary importBag(const std::string& bag_path, const std::string& folder, const BagImportOptions& options) {
+  options.validate();
   rosbag::Bag bag;
   detail::openForReading(bag, bag_path);
   BagImportSummary summary;
@@ -234,7 +258,7 @@ BagImportSummary importBag(const std::string& bag_path, const std::string& folde
       kind_of[name] = kind;
       names.push_back(name);
     }
-    SequenceSink sink(folder, summary);
+    SequenceSink sink(folder, options.events_format, summary);
     std::map<std::string, std::uint64_t> index;
     where = "reading the first message";
     rosbag::View view(bag, rosbag::TopicQuery(names));

@@ -35,6 +35,7 @@ void addImportCommand(CLI::App& app) {
     std::string bag;
     std::string folder;
     std::vector<std::string> topics;
+    std::string events_format = "txt";
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
@@ -44,10 +45,14 @@ void addImportCommand(CLI::App& app) {
   cmd->add_option("--topic", args->topics,
                   "kind=/name: read this topic for a kind (events, frames, imu, groundtruth, camera_info, sensors); "
                   "kind= skips it. Default: the bag's only topic of the kind's type");
+  cmd->add_option("--events", args->events_format,
+                  "events file: txt (events.txt, exact ns), h5 (events.h5, µs, with the sensor size) or both")
+      ->check(CLI::IsMember({"txt", "h5", "both"}));
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing on success");
   cmd->callback([args] {
     bags::BagImportOptions options;
     options.topics = bags::parseTopicOverrides(args->topics);
+    options.events_format = args->events_format;
     io::requireNotStaging(args->bag);
     io::StagedFolder out(args->folder);  // published whole, or not at all
     const auto summary = bags::importBag(args->bag, out.path(), options);

@@ -9,6 +9,8 @@
 #include "evio/bags/bag_import.h"
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
+#include "evio/core/io/calib_txt.h"
+#include "evio/core/io/events_h5.h"
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/imu_txt.h"
 #include "temp_dir.h"
@@ -68,6 +70,39 @@ TEST(BagExport, WindowsCountsAndTimeZero) {
   EXPECT_EQ(r.event_messages, 9u);
   EXPECT_EQ(io::readFile(back + "/events.txt"), io::readFile(seq + "/events.txt"));
   EXPECT_EQ(io::readFile(back + "/imu.txt"), io::readFile(seq + "/imu.txt"));
+}
+
+/// --events both: events.txt exact, events.h5 floored to µs with the sensor size.
+TEST(BagImport, EventsAsHdf5Too) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  fs::create_directories(seq);
+  EventArray events;
+  for (int i = 0; i < 30; ++i)
+    events.push_back(TimeNs{1'000'000'000} + TimeNs{i} * 123'457, static_cast<std::uint16_t>(i), 7, i % 3 == 0);
+  io::writeEventsText(seq + "/events.txt", events);
+  io::writeCalibTxt(seq + "/calib.txt", io::CalibTxt{Vec4(200, 200, 120, 90), VecX()});
+  exportBag(seq, dir.file("a.bag"));
+
+  const std::string back = dir.file("back");
+  fs::create_directories(back);
+  BagImportOptions options;
+  options.events_format = "both";
+  importBag(dir.file("a.bag"), back, options);
+  EXPECT_EQ(io::readFile(back + "/events.txt"), io::readFile(seq + "/events.txt"));
+  io::EventH5Reader h5(back + "/events.h5");
+  EXPECT_EQ(h5.width(), 30);  // the export's sensor size: the events' largest x + 1
+  EXPECT_EQ(h5.height(), 8);
+  EventArray read;
+  h5.read(0, h5.size(), read);
+  ASSERT_EQ(read.size(), events.size());
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    EXPECT_EQ(read.t()[i], events.t()[i] / 1000 * 1000);  // floored to the µs
+    EXPECT_EQ(read[i].x, events[i].x);
+    EXPECT_EQ(read[i].positive, events[i].positive);
+  }
+  options.events_format = "xml";
+  EXPECT_THROW(importBag(dir.file("a.bag"), back, options), Error);
 }
 
 TEST(BagExport, NegativeTimeAndEmptyFolderAreErrors) {

@@ -4,7 +4,8 @@
 /// into a sequence folder (docs/architecture.md#the-sequence-folder):
 ///
 ///   dvs_msgs/EventArray      → events.txt (t in s with 9 decimals: the
-///                              bag's nanoseconds exactly)
+///                              bag's nanoseconds exactly) and/or events.h5
+///                              (µs, with the sensor size; `events_format`)
 ///   sensor_msgs/Image        → images.txt, images/frame_XXXXXXXX.png (8-bit grey)
 ///   sensor_msgs/Imu          → imu.txt (specific force, angular rate; frame of the message)
 ///   geometry_msgs/PoseStamped→ groundtruth.txt (TUM; taken as T_W_E)
@@ -36,6 +37,13 @@ namespace evio::bags {
 
 struct BagImportOptions {
   TopicOverrides topics;  ///< kind → topic name ("" skips the kind)
+  /// Events file(s) to write: "txt" (events.txt, exact ns), "h5" (events.h5,
+  /// µs floored, with the sensor size as attributes; read faster and
+  /// preferred by the readers) or "both".
+  std::string events_format = "txt";
+
+  /// Throws evio::Error naming the option.
+  void validate() const;
 };
 
 /// What was imported.

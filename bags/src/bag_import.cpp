@@ -36,7 +36,12 @@ struct TopicType {
 std::map<std::string, TopicType> topicsOf(const rosbag::Bag& bag) {
   std::map<std::string, TopicType> out;
   rosbag::View all(bag);
-  for (const rosbag::ConnectionInfo* c : all.getConnections()) out[c->topic] = {c->datatype, c->md5sum};
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+    const auto [it, fresh] = out.try_emplace(c->topic, TopicType{c->datatype, c->md5sum});
+    if (!fresh && (it->second.type != c->datatype || it->second.md5 != c->md5sum))
+      throw Error(c->topic + ": carries two message types (" + it->second.type + " " + it->second.md5 + " and " +
+                  c->datatype + " " + c->md5sum + ")");
+  }
   return out;
 }
 

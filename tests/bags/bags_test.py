@@ -262,6 +262,12 @@ class BadBags(unittest.TestCase):
             bag.write("/dvs_rendering", msg, fx.ros_time(T0_NS + 5))
         self.expect_error([self.bag, "/dvs/image_raw", "/dvs_rendering", "--topic frames="])
 
+    def test_topic_with_two_types(self):
+        Data(3).write(self.bag)
+        with rosbag.Bag(self.bag, "a") as bag:
+            bag.write("/dvs/imu", String(data="not an IMU"), fx.ros_time(T0_NS + 5))
+        self.expect_error([self.bag, "/dvs/imu", "two message types", "std_msgs/String"])
+
     def test_unsorted_imu(self):
         d = Data(3)
         d.imu[10], d.imu[11] = d.imu[11], d.imu[10]

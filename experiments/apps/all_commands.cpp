@@ -13,6 +13,7 @@ void addAllCommands(CLI::App& app) {
   addCampaignCommand(app);
   addReportCommand(app);
   addExportCommand(app);
+  addImportCommand(app);
   addSimulateCommand(app);
   addEstimateCommand(app);
   addHealthCommand(app);

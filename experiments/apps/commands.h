@@ -25,6 +25,7 @@ void addEvaluateCommand(CLI::App& app);
 void addCampaignCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
+void addImportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addEstimateCommand(CLI::App& app);
 void addHealthCommand(CLI::App& app);

@@ -11,6 +11,14 @@ scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
+# The Python package installed under the prefix $1 runs the binary beside it, and reads a sequence.
+check_python() {
+  local prefix=$1 found
+  found=$(cd "$scratch" && PYTHONPATH=$prefix/lib/python3/dist-packages /usr/bin/python3 -c 'import evio; print(evio.binary())') \
+    || fail "import evio from $prefix"
+  [[ $(realpath "$found") == $(realpath "$prefix/bin/evio") ]] || fail "the package under $prefix runs $found"
+}
+
 # Runs the installed binary $1 in an empty folder on a short simulated sequence.
 exercise() {
   local evio=$1 work
@@ -40,6 +48,7 @@ evio=$scratch/prefix/bin/evio
 [[ -f $scratch/prefix/share/evio/experiments/campaigns/main.yaml ]] || fail "campaigns not installed"
 if strings "$evio" | grep -qF "$source"; then fail "the installed binary contains the source path $source"; fi
 exercise "$evio"
+check_python "$scratch/prefix"
 
 # 2. Without its data folder the binary says which folder is missing (exit 1).
 mv "$scratch/prefix/share/evio" "$scratch/moved"
@@ -57,4 +66,5 @@ deb=$(ls "$scratch"/pkg/*.deb)
 dpkg-deb -f "$deb" Depends | grep -q libembree || fail "package depends on no libembree: $(dpkg-deb -f "$deb" Depends)"
 dpkg-deb -x "$deb" "$scratch/root"
 exercise "$scratch/root/usr/bin/evio"
+check_python "$scratch/root/usr"
 echo "install test passed: prefix, moved data folder, Debian package ($(basename "$deb"))"

@@ -152,6 +152,7 @@ void EventCamera::Options::validate() const {
   requireNonNegative("threshold_jitter_sigma", threshold_jitter_sigma);
   requirePositive("threshold_min", threshold_min);
   requireNonNegative("refractory_period_s", refractory_period_s);
+  requireInRange("refractory_mismatch_sigma", refractory_mismatch_sigma, 0.0, 1.0);
   requirePositive("log_eps_w_m2_sr", log_eps_w_m2_sr);
   requireNonNegative("cutoff_max_hz", cutoff_max_hz);
   requirePositive("cutoff_min_hz", cutoff_min_hz);
@@ -218,6 +219,13 @@ EventCamera::EventCamera(int width, int height, const Options& options, std::uin
   shot_ = options_.shot_noise_rate_hz > 0.0;
   jitter_ = options_.threshold_jitter_sigma > 0.0;
   refractory_ns_ = secondsToNs(options_.refractory_period_s);
+  if (options_.refractory_mismatch_sigma > 0.0) {
+    const std::uint64_t key = counterKey(seed, "event_refractory_mismatch");
+    refractory_px_.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+    for (std::size_t i = 0; i < refractory_px_.size(); ++i)
+      refractory_px_[i] = secondsToNs(options_.refractory_period_s *
+                                      std::exp(options_.refractory_mismatch_sigma * counterNormal(key, i, 0)));
+  }
 
   t_prev_.assign(n_, 0);
   t_last_event_.assign(n_, std::numeric_limits<TimeNs>::min() / 2);
@@ -425,6 +433,7 @@ void EventCamera::crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float
   const double dl = static_cast<double>(l1) - static_cast<double>(l0);
   const double span = static_cast<double>(t1 - t0);
   const float c_min = static_cast<float>(options_.threshold_min);
+  const TimeNs refractory = refractoryNs(i);
   float base_pos = 0.0f, base_neg = 0.0f;
   if (jitter_) {
     base_pos = thresholdPos(i);
@@ -434,7 +443,7 @@ void EventCamera::crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float
     double frac = dl != 0.0 ? (static_cast<double>(r) - static_cast<double>(l0)) / dl : 1.0;
     frac = std::clamp(frac, 0.0, 1.0);
     const TimeNs t = std::clamp<TimeNs>(t0 + static_cast<TimeNs>(frac * span + 0.5), t0 + 1, t1);
-    if (t - t_last_event_[i] >= refractory_ns_) {
+    if (t - t_last_event_[i] >= refractory) {
       out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
                              EventLabel::kSignal});
       t_last_event_[i] = t;
@@ -468,12 +477,20 @@ void EventCamera::shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, f
   double acc = static_cast<double>(shot_budget_[i]);
   const double h = static_cast<double>(hazard);
   std::uint32_t k = shot_count_[i];
+  const TimeNs refractory = refractoryNs(i);
   while (acc <= h) {
     const TimeNs t =
         std::clamp<TimeNs>(t0 + static_cast<TimeNs>(acc / static_cast<double>(rate_hz) * 1e9 + 0.5), t0 + 1, t1);
     const bool positive = counterUniform(key_shot_, i, 2ull * k + 1) < 0.5;
-    out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
-                           EventLabel::kShot});
+    // A shot event is a real reset of the pixel: none within the refractory
+    // period of the pixel's last emitted event, on either side (the signal
+    // crossings of this interval are placed first).
+    const TimeNs gap = t - t_last_event_[i];
+    if (gap >= refractory || -gap >= refractory) {
+      out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
+                             EventLabel::kShot});
+      t_last_event_[i] = std::max(t_last_event_[i], t);
+    }
     ++k;
     acc += counterExponential(key_shot_, i, 2ull * k);
   }

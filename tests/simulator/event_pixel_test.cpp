@@ -8,6 +8,7 @@
 // new stage on; the DAVIS240C presets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -137,6 +138,25 @@ TEST(EventPixel, RefractoryPeriodLeavesMultiplesOfTheCrossingPeriod) {
   }
 }
 
+TEST(EventPixel, RefractoryMismatchIsLogNormalPerPixel) {
+  // R_i = R exp(σ z_i): over 40 000 pixels the median of R_i is R and the
+  // standard deviation of ln(R_i / R) is σ, each within 2 %.
+  EventCamera::Options o;
+  o.refractory_period_s = 0.002;
+  o.refractory_mismatch_sigma = 0.2;
+  EventCamera cam(200, 200, o, 3);
+  std::vector<double> logs;
+  for (std::size_t i = 0; i < cam.pixelCount(); ++i)
+    logs.push_back(std::log(static_cast<double>(cam.refractoryNs(i)) / 2e6));
+  double mean = 0.0, var = 0.0;
+  for (const double l : logs) mean += l;
+  mean /= static_cast<double>(logs.size());
+  for (const double l : logs) var += (l - mean) * (l - mean);
+  std::nth_element(logs.begin(), logs.begin() + static_cast<std::ptrdiff_t>(logs.size() / 2), logs.end());
+  EXPECT_NEAR(std::exp(logs[logs.size() / 2]), 1.0, 0.02);
+  EXPECT_NEAR(std::sqrt(var / static_cast<double>(logs.size())), 0.2, 0.004);
+}
+
 TEST(EventPixel, EventsPerEdgeCrossingAreTheContrastOverTheThreshold) {
   // An edge of log contrast ΔL = 0.95 passes a band-limited pixel and back:
   // floor(ΔL / C⁺) ON events up, then floor((r − L_0) / C⁻) OFF events down,
@@ -227,6 +247,29 @@ TEST(EventPixel, ShotNoiseRateFollowsThePhotocurrent) {
   for (std::size_t i = 0; i < ev.size(); ++i) on += ev[i].positive ? 1 : 0;
   EXPECT_NEAR(static_cast<double>(ev.size()), 125'000.0, 2'500.0);
   EXPECT_NEAR(static_cast<double>(on) / static_cast<double>(ev.size()), 0.5, 0.01);  // both polarities
+}
+
+TEST(EventPixel, ShotNoiseObeysTheRefractoryPeriodAsADeadTime) {
+  // Shot events reset the pixel, so the refractory period R is a
+  // non-paralysable dead time: the emitted rate is r / (1 + r R) and no
+  // same-pixel interval is shorter than R. r = 200 Hz (dark), R = 5 ms:
+  // 100 Hz; 20×20 pixels over 10 s expect 400 000 events; within 2 %.
+  EventCamera::Options o;
+  o.shot_noise_rate_hz = 200.0;
+  o.refractory_period_s = 0.005;
+  const std::vector<float> dark(400, 0.0f);
+  EventCamera cam(20, 20, o, 9);
+  EventArray ev;
+  for (int k = 0; k <= 1000; ++k) cam.update(k * 10 * kNsPerMs, dark.data(), &ev, nullptr);
+  EXPECT_NEAR(static_cast<double>(ev.size()), 400'000.0, 8'000.0);
+  std::vector<TimeNs> last(400, -1000 * kNsPerMs);
+  TimeNs shortest = 1000 * kNsPerMs;
+  for (std::size_t i = 0; i < ev.size(); ++i) {
+    const std::size_t p = static_cast<std::size_t>(ev[i].y) * 20 + ev[i].x;
+    shortest = std::min(shortest, ev[i].t_ns - last[p]);
+    last[p] = ev[i].t_ns;
+  }
+  EXPECT_GE(shortest, 5 * kNsPerMs);
 }
 
 TEST(EventPixel, OutputWithEveryStageOnDoesNotDependOnThreads) {

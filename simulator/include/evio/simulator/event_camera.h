@@ -40,10 +40,15 @@
 ///  4. Thresholds: C^±_i = max(C_min, C^± + σ_m z^±_i), z fixed per pixel
 ///     (stream "event_threshold_mismatch"); with jitter σ_j > 0 the threshold
 ///     of crossing k is max(C_min, C^±_i + σ_j z^±_{i,k}) ("event_jitter").
-///  5. Refractory period: a crossing less than refractory_period_s after the
+///  5. Refractory period R_i = R · exp(σ_R z_i), z_i fixed per pixel
+///     ("event_refractory_mismatch"; σ_R = 0: every pixel R), the spread of
+///     the pixel's refractory transistor: a crossing less than R_i after the
 ///     pixel's last emitted signal event moves r but emits nothing.
-///  6. Noise, independent of the pixel's reference (noise events neither move
-///     r nor start a refractory period), each with its own label:
+///  6. Noise, independent of the pixel's reference (noise events do not move
+///     r), each with its own label. Shot events reset the pixel like signal
+///     events: none is emitted within refractory_period_s of the pixel's last
+///     emitted event (either side), and an emitted one starts a refractory
+///     period. Leak and hot-pixel events ignore the refractory period:
 ///     - leak: ON events, Poisson at leak_rate_hz per pixel ("event_leak");
 ///     - shot: ON or OFF with equal probability, Poisson per pixel at
 ///         r_shot(I) = R_shot (1 − (1 − b) · I / (I + I_ref)),
@@ -116,7 +121,8 @@ class EventCamera {
     double threshold_mismatch_sigma = 0.03; ///< σ_m of the fixed per-pixel threshold offset, log units
     double threshold_jitter_sigma = 0.0;    ///< σ_j of the per-crossing threshold noise, log units
     double threshold_min = 0.01;            ///< C_min, lower clamp of every threshold, log units
-    double refractory_period_s = 0.0;       ///< dead time after an emitted signal event, s
+    double refractory_period_s = 0.0;       ///< dead time after an emitted signal or shot event, s
+    double refractory_mismatch_sigma = 0.0; ///< σ_R of the per-pixel log refractory period
     double log_eps_w_m2_sr = 1e-3;          ///< ε of L = log(ε + I), W/(m²·sr)
     double cutoff_max_hz = 0.0;             ///< photoreceptor cut-off in bright light, Hz; 0 = ideal (no filter)
     double cutoff_min_hz = 1.0;             ///< cut-off floor in the dark, Hz
@@ -147,6 +153,7 @@ class EventCamera {
       v("threshold_jitter_sigma", threshold_jitter_sigma, "per-crossing threshold sigma, log units");
       v("threshold_min", threshold_min, "lower clamp of thresholds, log units");
       v("refractory_period_s", refractory_period_s, "refractory period, s");
+      v("refractory_mismatch_sigma", refractory_mismatch_sigma, "per-pixel sigma of log refractory period");
       v("log_eps_w_m2_sr", log_eps_w_m2_sr, "epsilon of log(eps + I), W/(m^2 sr)");
       v("cutoff_max_hz", cutoff_max_hz, "photoreceptor cut-off in bright light, Hz (0 = ideal)");
       v("cutoff_min_hz", cutoff_min_hz, "photoreceptor cut-off floor in the dark, Hz");
@@ -226,6 +233,8 @@ class EventCamera {
   /// The pixel's fixed thresholds C^±_i (before per-crossing jitter).
   float thresholdPos(std::size_t i) const;
   float thresholdNeg(std::size_t i) const;
+  /// The refractory period of pixel i, ns.
+  TimeNs refractoryNs(std::size_t i) const { return refractory_px_.empty() ? refractory_ns_ : refractory_px_[i]; }
   /// Whether pixel i is hot.
   bool isHot(std::size_t i) const;
   /// Events waiting in the pending buffer.
@@ -259,11 +268,12 @@ class EventCamera {
   bool initialized_ = false;
   bool bandwidth_ = false, follower_ = false, shot_ = false, jitter_ = false;
   TimeNs refractory_ns_ = 0;
+  std::vector<TimeNs> refractory_px_;   ///< per-pixel refractory period (empty when σ_R = 0)
   TimeNs t_init_ = 0;
 
   // Per-pixel state (structure of arrays).
   std::vector<TimeNs> t_prev_;          ///< last sample time
-  std::vector<TimeNs> t_last_event_;    ///< last emitted signal event (refractory)
+  std::vector<TimeNs> t_last_event_;    ///< last emitted signal or shot event (refractory)
   std::vector<float> lin_prev_;         ///< L_in at the last sample
   std::vector<float> lf_prev_;          ///< L_f at the last sample
   std::vector<float> lpr_prev_;         ///< L_p at the last sample (source follower only)

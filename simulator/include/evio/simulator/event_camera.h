@@ -70,7 +70,8 @@
 /// time alone: the superposition of N Poisson processes of rate r is one of
 /// rate N·r with a uniformly drawn pixel, drawn from a sequential stream.
 /// Memory is flat: 48 bytes of state per pixel (+4 with the source
-/// follower, +8 with the BA filter) plus the events pending.
+/// follower, +8 with the BA filter, +8 with a refractory spread) plus the
+/// events pending.
 ///
 /// How to drive it from a render loop:
 ///  - Whole frames: `update(t, radiance, &events, &labels)` once per render

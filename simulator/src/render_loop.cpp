@@ -35,7 +35,7 @@ CameraVelocity cameraVelocity(const TrajectoryState& s, const Pose& T_B_C) {
 class StepPredictor {
  public:
   StepPredictor(const RenderScheduleOptions& o, const EventCamera::Options& ec)
-      : sampler_(samplerOptions(o), std::min(ec.threshold_pos, ec.threshold_neg), ec.log_eps_w_m2_sr),
+      : sampler_(samplerOptions(o), std::min(ec.threshold_pos, ec.threshold_neg), ec.logEpsilon()),
         quantile_(o.fastest_pixel_quantile) {}
 
   TimeNs interval(const cv::Mat& radiance, const cv::Mat& flow) {

@@ -76,7 +76,7 @@ TEST(Scenario, OverridesReachPresetSections) {
                                   EVIO_SOURCE_DIR);
   EXPECT_EQ(s.end_ns - s.start_ns, 2 * kNsPerSecond);
   EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_pos, 0.3);
-  EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_neg, 0.2);  // kept from the preset
+  EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_neg, 0.38);  // kept from the preset
   EXPECT_EQ(s.scene.options.seed, 9u);
   const std::string yaml = s.resolvedYaml();
   EXPECT_NE(yaml.find("diameter_m: 2.5"), std::string::npos);

@@ -1,0 +1,364 @@
+#include "evio/estimator/frontend/haste_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "evio/core/error.h"
+#include "evio/core/random_stream.h"
+#include "evio/estimator/frontend/frontend.h"
+#include "synthetic_events.h"
+
+namespace evio::estimator {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+/// A rigid pattern of dots: events fire at the dots' pixels (nearest pixel
+/// centre), one event every dt_s at a dot drawn at random, optionally mixed
+/// with noise events uniform over the disc of radius `noise_radius_px`
+/// around the pattern centre. Exact truth: centre(t) = c0 + v t, angle(t) = ω t,
+/// dot j at centre(t) + R(angle(t)) d_j.
+struct DotPattern {
+  Vec2 c0 = Vec2(60.0, 60.0);
+  Vec2 velocity_px_s = Vec2::Zero();
+  double omega_rad_s = 0.0;
+  std::vector<Vec2> dots;
+
+  static DotPattern random(std::uint64_t seed, int count, double radius_px) {
+    RandomStream rng(seed, "haste_dots");
+    DotPattern p;
+    while (static_cast<int>(p.dots.size()) < count) {
+      const Vec2 d(rng.uniform(-radius_px, radius_px), rng.uniform(-radius_px, radius_px));
+      if (d.norm() <= radius_px) p.dots.push_back(d);
+    }
+    return p;
+  }
+  Vec2 centre(double t) const { return c0 + velocity_px_s * t; }
+  double angle(double t) const { return omega_rad_s * t; }
+  Vec2 dot(std::size_t j, double t) const {
+    const double a = angle(t);
+    const Vec2& d = dots[j];
+    return centre(t) + Vec2(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y());
+  }
+};
+
+struct PatternEvent {
+  TimeNs t_ns;
+  int x, y;
+};
+
+std::vector<PatternEvent> patternEvents(const DotPattern& p, double duration_s, double dt_s, double noise_fraction,
+                                        double noise_radius_px, std::uint64_t seed) {
+  RandomStream rng(seed, "haste_events");
+  std::vector<PatternEvent> out;
+  const int n = static_cast<int>(duration_s / dt_s);
+  out.reserve(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const double t = k * dt_s;
+    Vec2 e;
+    if (rng.uniform() < noise_fraction) {
+      do {
+        e = Vec2(rng.uniform(-noise_radius_px, noise_radius_px), rng.uniform(-noise_radius_px, noise_radius_px));
+      } while (e.norm() > noise_radius_px);
+      e += p.centre(t);
+    } else {
+      e = p.dot(static_cast<std::size_t>(rng.uniformInt(p.dots.size())), t);
+    }
+    out.push_back(PatternEvent{secondsToNs(t), static_cast<int>(std::lround(e.x())), static_cast<int>(std::lround(e.y()))});
+  }
+  return out;
+}
+
+HasteOptions optionsFor(const std::string& variant) {
+  HasteOptions o;
+  o.variant = variant;
+  return o;
+}
+
+const std::vector<std::string> kVariants = {"haste_correlation", "haste_correlation_star", "haste_difference",
+                                            "haste_difference_star"};
+
+class HasteVariants : public ::testing::TestWithParam<std::string> {};
+
+INSTANTIATE_TEST_SUITE_P(All, HasteVariants, ::testing::ValuesIn(kVariants),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// A dot pattern translating at (30, −15) px/s and rotating at 20 °/s for 2 s
+// (67 px, 40°): after the start, the state stays within one hypothesis step
+// (1 px on each axis, 4°) of the true centre and angle at the state's time.
+TEST_P(HasteVariants, TranslatingRotatingPatternGivesTheKnownTrackWithinOneStep) {
+  DotPattern p = DotPattern::random(7, 40, 11.0);
+  p.velocity_px_s = Vec2(30.0, -15.0);
+  p.omega_rad_s = 20.0 * kDeg;
+  const HasteOptions o = optionsFor(GetParam());
+  HasteFeature f(o);
+  f.reset(HasteState{0, p.c0.x(), p.c0.y(), 0.0});
+  int jumps = 0;
+  double worst_px = 0.0, worst_rad = 0.0;
+  for (const PatternEvent& e : patternEvents(p, 2.0, 50e-6, 0.0, 0.0, 1)) {
+    const HasteFeature::Update u = f.addEvent(e.t_ns, e.x, e.y);
+    if (u == HasteFeature::Update::kJump) ++jumps;
+    if (!f.started()) continue;
+    const HasteState& s = f.state();
+    const double t = nsToSeconds(s.t_ns);
+    worst_px = std::max({worst_px, std::abs(s.x - p.centre(t).x()), std::abs(s.y - p.centre(t).y())});
+    worst_rad = std::max(worst_rad, std::abs(s.theta - p.angle(t)));
+  }
+  EXPECT_LE(worst_px, o.step_px) << GetParam();
+  EXPECT_LE(worst_rad, o.step_deg * kDeg) << GetParam();
+  EXPECT_GT(jumps, 67) << "the pattern moved 67 px and 40 degrees";
+  RecordProperty("worst_px", std::to_string(worst_px));
+  RecordProperty("worst_deg", std::to_string(worst_rad / kDeg));
+}
+
+// The scores kept incrementally (caches, O(1) updates) equal the scores
+// computed from the window and the reference alone, for every hypothesis,
+// after every event, across state jumps. Scores are O(1e-3); 1e-12 absolute.
+TEST_P(HasteVariants, IncrementalScoreEqualsScoreFromScratchAfterEveryEvent) {
+  DotPattern p = DotPattern::random(11, 40, 11.0);
+  p.velocity_px_s = Vec2(-25.0, 20.0);
+  p.omega_rad_s = -15.0 * kDeg;
+  HasteFeature f(optionsFor(GetParam()));
+  f.reset(HasteState{0, p.c0.x(), p.c0.y(), 0.0});
+  int checked = 0, jumps = 0;
+  double worst = 0.0, scale = 0.0;
+  for (const PatternEvent& e : patternEvents(p, 1.0, 50e-6, 0.1, 15.0, 2)) {
+    if (f.addEvent(e.t_ns, e.x, e.y) == HasteFeature::Update::kJump) ++jumps;
+    if (!f.started()) continue;
+    for (int h = 0; h < HasteFeature::kHypotheses; ++h) {
+      const double scratch = f.scoreFromScratch(h);
+      worst = std::max(worst, std::abs(f.score(h) - scratch));
+      scale = std::max(scale, std::abs(scratch));
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 15000);
+  EXPECT_GT(jumps, 20);
+  EXPECT_GT(scale, 1e-5);
+  EXPECT_LE(worst, 1e-12) << GetParam() << " (largest |score| " << scale << ")";
+}
+
+// A still scene: events repeat at the pattern's pixels (e.g. under flickering
+// light), 20 % of them noise anywhere within the patch. 100 000 events: the
+// state never leaves the seed.
+TEST_P(HasteVariants, StillSceneWithNoiseNeverMovesTheState) {
+  const DotPattern p = DotPattern::random(5, 40, 11.0);
+  HasteFeature f(optionsFor(GetParam()));
+  f.reset(HasteState{0, p.c0.x(), p.c0.y(), 0.0});
+  int jumps = 0;
+  for (const PatternEvent& e : patternEvents(p, 5.0, 50e-6, 0.2, 15.0, 3))
+    if (f.addEvent(e.t_ns, e.x, e.y) == HasteFeature::Update::kJump) ++jumps;
+  ASSERT_TRUE(f.started());
+  EXPECT_EQ(jumps, 0) << GetParam();
+  EXPECT_EQ(f.state().x, p.c0.x());
+  EXPECT_EQ(f.state().y, p.c0.y());
+  EXPECT_EQ(f.state().theta, 0.0);
+}
+
+TEST(HasteFeature, WindowSizeAndHypothesesAreThePublishedOnes) {
+  const HasteOptions o;
+  EXPECT_EQ(o.windowSize(), 193);  // 1 + 2⌊0.2·31²/2⌋
+  HasteFeature f(o);
+  f.reset(HasteState{0, 10.0, 20.0, 0.5});
+  EXPECT_EQ(f.windowSize(), 193);
+  int translations = 0, rotations = 0;
+  for (int h = 1; h < HasteFeature::kHypotheses; ++h) {
+    const HasteState& s = f.hypothesis(h);
+    const double dx = s.x - 10.0, dy = s.y - 20.0, dt = s.theta - 0.5;
+    if (dt == 0.0) {
+      EXPECT_EQ(std::max(std::abs(dx), std::abs(dy)), 1.0);
+      ++translations;
+    } else {
+      EXPECT_NEAR(std::abs(dt), 4.0 * kDeg, 1e-15);
+      EXPECT_EQ(dx, 0.0);
+      EXPECT_EQ(dy, 0.0);
+      ++rotations;
+    }
+  }
+  EXPECT_EQ(translations, 8);
+  EXPECT_EQ(rotations, 2);
+}
+
+TEST(HasteFeature, EventsOutsideTheDiscAreIgnored) {
+  HasteFeature f(HasteOptions{});
+  f.reset(HasteState{0, 50.0, 50.0, 0.0});
+  EXPECT_EQ(f.addEvent(1, 65, 50), HasteFeature::Update::kOutOfRange);  // |d| = h = 15
+  EXPECT_EQ(f.addEvent(1, 64, 50), HasteFeature::Update::kFilling);
+  EXPECT_EQ(f.windowCount(), 1);
+}
+
+TEST(HasteOptions, BadValuesNameTheField) {
+  HasteOptions o;
+  o.variant = "haste_fast";
+  EXPECT_THROW(
+      {
+        try {
+          o.validate();
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("variant"), std::string::npos);
+          throw;
+        }
+      },
+      Error);
+  o = HasteOptions{};
+  o.patch_size_px = 30;
+  EXPECT_THROW(o.validate(), Error);
+  o = HasteOptions{};
+  o.margin = -0.1;
+  EXPECT_THROW(o.validate(), Error);
+  o = HasteOptions{};
+  o.window_factor = 0.001;
+  EXPECT_THROW(o.validate(), Error);
+  FrontendOptions fo;
+  fo.tracker = "hast";
+  EXPECT_THROW(fo.validate(), Error);
+  fo.tracker = "haste";
+  EXPECT_NO_THROW(fo.validate());
+}
+
+// ---------------------------------------------------------------------------
+// The tracker: seeding, centred initialisation, track points, loss.
+
+constexpr int kWidth = 160;
+constexpr int kHeight = 120;
+
+Camera testCamera() { return Camera::create("pinhole", kWidth, kHeight, Vec4(150, 150, 79.5, 59.5), VecX()); }
+
+EventArray toArray(const std::vector<PatternEvent>& events, TimeNs offset_ns = 0) {
+  EventArray a;
+  for (const PatternEvent& e : events)
+    if (e.x >= 0 && e.y >= 0 && e.x < kWidth && e.y < kHeight)
+      a.push_back(e.t_ns + offset_ns, static_cast<std::uint16_t>(e.x), static_cast<std::uint16_t>(e.y), true);
+  return a;
+}
+
+// With the centred initialisation the window starts with the (N − 1)/2
+// newest in-range events before the seed, so the first state is stamped
+// with the first in-range event after it.
+TEST(HasteTracker, CentredInitialisationStampsTheFirstStateAtTheSeed) {
+  const DotPattern p = DotPattern::random(3, 40, 11.0);
+  const std::vector<PatternEvent> events = patternEvents(p, 0.04, 50e-6, 0.0, 0.0, 4);
+  HasteTracker tracker(HasteOptions{}, testCamera());
+  const EventArray all = toArray(events);
+  const std::size_t split = all.size() / 2;  // 20 ms: 400 events before the seed
+  tracker.addEvents(all, 0, split);
+  const FeatureId id = tracker.addFeature(p.c0, all.t()[split - 1]);
+  tracker.addEvents(all, split, all.size());
+  TrackPoints points;
+  tracker.drainTrackPoints(points);
+  ASSERT_FALSE(points.empty());
+  EXPECT_EQ(points.front().feature_id, id);
+  EXPECT_EQ(points.front().status, TrackStatus::kNew);
+  EXPECT_EQ(points.front().t_ns, all.t()[split]);
+  EXPECT_EQ(points.front().uv, p.c0);
+}
+
+// A pattern crossing the image: kNew, then kTracked points within one step of
+// the truth at increasing times, and kLost once the state is within
+// lost_border_px of the right edge.
+TEST(HasteTracker, TracksAPatternAcrossTheImageAndLosesItAtTheBorder) {
+  DotPattern p = DotPattern::random(9, 40, 11.0);
+  p.c0 = Vec2(40.0, 60.0);
+  p.velocity_px_s = Vec2(100.0, 10.0);
+  HasteOptions o;
+  HasteTracker tracker(o, testCamera());
+  tracker.addFeature(p.c0, 0);
+  tracker.addEvents(toArray(patternEvents(p, 1.2, 20e-6, 0.05, 15.0, 5)));
+  TrackPoints points;
+  tracker.drainTrackPoints(points);
+  ASSERT_GE(points.size(), 3u);
+  EXPECT_EQ(points.front().status, TrackStatus::kNew);
+  EXPECT_EQ(points.back().status, TrackStatus::kLost);
+  EXPECT_EQ(tracker.numAlive(), 0u);
+  TimeNs previous = -1;
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    const TrackPoint& q = points[i];
+    EXPECT_GT(q.t_ns, previous);
+    previous = q.t_ns;
+    const Vec2 truth = p.centre(nsToSeconds(q.t_ns));
+    EXPECT_LE((q.uv - truth).cwiseAbs().maxCoeff(), o.step_px) << "point " << i;
+  }
+  const TrackPoint& last = points[points.size() - 2];
+  EXPECT_EQ(points.back().uv, last.uv);  // kLost repeats the last good point
+  EXPECT_GE(last.uv.x(), kWidth - 1 - o.lost_border_px - o.step_px);
+  EXPECT_LE(last.uv.x(), kWidth - 1 - o.lost_border_px);
+}
+
+// Seeding on frames: Harris corners of a textured frame become features that
+// follow the texture's known motion (events from thresholding the exact log
+// intensity); every track point within 1.5 px of the true position of its
+// seed point (one step plus the corner's half-pixel and the event image's
+// trailing of a moving edge).
+TEST(HasteTracker, SeedsOnFrameCornersAndFollowsTheTexture) {
+  const test::BlobTexture tex = test::BlobTexture::random(21, kWidth, kHeight, 90);
+  test::RigidMotion m;
+  m.velocity_px_s = Vec2(25.0, -10.0);
+  m.centre = Vec2(80, 60);
+  m.omega_rad_s = 5.0 * kDeg;
+  HasteOptions o;
+  o.max_features = 12;
+  o.min_features = 12;
+  HasteTracker tracker(o, testCamera());
+  const EventArray before = test::generateEvents(tex, m, test::Roi{0, 0, kWidth, kHeight}, -0.02, 0.0, 2e-4, 0.05);
+  tracker.addEvents(before);
+  tracker.addFrame(0, test::render8(tex, m, 0.0, kWidth, kHeight));
+  ASSERT_GT(tracker.numAlive(), 5u);
+  tracker.addEvents(test::generateEvents(tex, m, test::Roi{0, 0, kWidth, kHeight}, 0.0, 0.5, 2e-4, 0.05));
+  TrackPoints points;
+  tracker.drainTrackPoints(points);
+  std::map<FeatureId, Vec2> seed;  // the texture point under each track's first sample
+  int checked = 0;
+  double worst = 0.0;
+  for (const TrackPoint& q : points) {
+    if (q.status == TrackStatus::kNew) seed[q.feature_id] = q.uv;  // stamped at ≈ the frame (t = 0)
+    if (q.status != TrackStatus::kTracked) continue;
+    const Vec2 truth = m.forward(seed.at(q.feature_id), nsToSeconds(q.t_ns));
+    worst = std::max(worst, (q.uv - truth).norm());
+    ++checked;
+  }
+  EXPECT_GT(seed.size(), 5u);
+  EXPECT_GT(checked, 50);
+  EXPECT_LE(worst, 1.5);
+  RecordProperty("worst_px", std::to_string(worst));
+}
+
+}  // namespace
+}  // namespace evio::estimator
+namespace evio::estimator {
+namespace {
+TEST(HasteExplore, Sweep) {
+  const char* e = std::getenv("HASTE_EXPLORE");
+  if (!e) GTEST_SKIP();
+  for (const std::string& variant : kVariants)
+    for (double radius : {11.0, 14.0})
+      for (int mode = 0; mode < 3; ++mode) {
+        DotPattern p = DotPattern::random(7, radius > 12 ? 60 : 40, radius);
+        if (mode != 1) p.velocity_px_s = Vec2(30.0, -15.0);
+        if (mode != 0) p.omega_rad_s = 20.0 * kDeg;
+        HasteFeature f(optionsFor(variant));
+        f.reset(HasteState{0, p.c0.x(), p.c0.y(), 0.0});
+        double worst_px = 0.0, worst_rad = 0.0, sum_px = 0.0, sum_rad = 0.0;
+        int n = 0;
+        for (const PatternEvent& ev : patternEvents(p, 2.0, 50e-6, 0.0, 0.0, 1)) {
+          f.addEvent(ev.t_ns, ev.x, ev.y);
+          if (!f.started()) continue;
+          const HasteState& s = f.state();
+          const double t = nsToSeconds(s.t_ns);
+          const double ex = std::max(std::abs(s.x - p.centre(t).x()), std::abs(s.y - p.centre(t).y()));
+          worst_px = std::max(worst_px, ex);
+          worst_rad = std::max(worst_rad, std::abs(s.theta - p.angle(t)));
+          sum_px += ex; sum_rad += std::abs(s.theta - p.angle(t)); ++n;
+        }
+        std::printf("%-24s r=%4.1f mode=%d worst %.3f px %.2f deg  mean %.3f px %.2f deg  final theta %.2f (truth %.2f)\n",
+                    variant.c_str(), radius, mode, worst_px, worst_rad / kDeg, sum_px / n, sum_rad / n / kDeg,
+                    f.state().theta / kDeg, p.angle(nsToSeconds(f.state().t_ns)) / kDeg);
+      }
+}
+}  // namespace
+}  // namespace evio::estimator

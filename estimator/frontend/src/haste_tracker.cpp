@@ -20,6 +20,7 @@ struct HasteTracker::Slot {
   PixelRect rect;                 // where the grid has this slot's bit
   Vec2 last_uv = Vec2::Zero();    // last point sent
   TimeNs last_t_ns = 0;
+  bool pending = false;           // the state moved since the last point sent
 };
 
 HasteTracker::HasteTracker(const HasteOptions& options, const Camera& camera)
@@ -126,28 +127,35 @@ void HasteTracker::recordHistory(TimeNs t_ns, int x, int y) {
 
 void HasteTracker::onUpdate(int index, HasteFeature::Update update) {
   Slot& s = slots_[static_cast<std::size_t>(index)];
-  if (update != HasteFeature::Update::kStarted && update != HasteFeature::Update::kJump) return;
+  if (update == HasteFeature::Update::kOutOfRange || update == HasteFeature::Update::kFilling) return;
   const HasteState& st = s.feature.state();
   const Vec2 uv(st.x, st.y);
-  const bool inside = st.x >= border_px_ && st.y >= border_px_ && st.x <= width_ - 1 - border_px_ &&
-                      st.y <= height_ - 1 - border_px_;
   if (update == HasteFeature::Update::kStarted) {
     s.state = Slot::State::kStarted;
+    s.pending = false;
     s.last_uv = uv;
     s.last_t_ns = st.t_ns;
     out_.push_back(TrackPoint{s.id, st.t_ns, uv, 1.0, TrackStatus::kNew});
     return;
   }
-  ++counters_.jumps;
-  if (!inside) {
-    out_.push_back(TrackPoint{s.id, s.last_t_ns, s.last_uv, 1.0, TrackStatus::kLost});
-    free(index);
-    return;
+  if (update == HasteFeature::Update::kJump) {
+    ++counters_.jumps;
+    const bool inside = st.x >= border_px_ && st.y >= border_px_ && st.x <= width_ - 1 - border_px_ &&
+                        st.y <= height_ - 1 - border_px_;
+    if (!inside) {
+      out_.push_back(TrackPoint{s.id, s.last_t_ns, s.last_uv, 1.0, TrackStatus::kLost});
+      free(index);
+      return;
+    }
+    moveRect(index);
+    s.pending = true;
   }
+  if (!s.pending) return;
+  if (options_.one_point_per_window && st.t_ns - s.last_t_ns < s.feature.windowSpanNs()) return;
+  s.pending = false;
   s.last_uv = uv;
   s.last_t_ns = st.t_ns;
   out_.push_back(TrackPoint{s.id, st.t_ns, uv, 1.0, TrackStatus::kTracked});
-  moveRect(index);
 }
 
 void HasteTracker::addEvents(const EventArray& events, std::size_t begin, std::size_t end) {

@@ -77,6 +77,10 @@ class HasteFeature {
   const HasteState& state() const { return hypotheses_[kNull]; }
   /// Events stored so far (≤ N before the start, N after).
   int windowCount() const { return count_; }
+  /// Time between the oldest and the newest event of the window (0 before the start).
+  TimeNs windowSpanNs() const {
+    return started_ ? et_[static_cast<std::size_t>(ringIndex(n_ - 1))] - et_[static_cast<std::size_t>(head_)] : 0;
+  }
   int windowSize() const { return n_; }
 
   /// Hypothesis h and its incrementally maintained score.

@@ -55,6 +55,13 @@ struct HasteOptions {
   int history_events = 32768;        ///< recent events kept for the centred initialisation
   double seed_timeout_s = 1.0;       ///< a seed that has not filled its window in this time is dropped
 
+  /// Send a new state at most once per window span (the time the window's N
+  /// events cover, the state's own time support); a jump within it is sent
+  /// when the span has passed. Off: every jump is a track point. The
+  /// synchroniser extrapolates from a track's last two points, and two jumps
+  /// a few µs apart would give it a velocity of px per µs.
+  bool one_point_per_window = true;
+
   // Ending tracks.
   double lost_border_px = 15.0;      ///< lost when the state comes closer than this to the image edge
 
@@ -76,6 +83,7 @@ struct HasteOptions {
     v("centered_initialization", centered_initialization, "first half of the window from events before the seed");
     v("history_events", history_events, "recent events kept for the centred initialisation");
     v("seed_timeout_s", seed_timeout_s, "drop a seed whose window is not full after this long, s");
+    v("one_point_per_window", one_point_per_window, "send a new state at most once per window time span");
     v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
   }
 

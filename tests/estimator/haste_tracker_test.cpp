@@ -294,10 +294,30 @@ TEST(HasteTracker, TracksAPatternAcrossTheImageAndLosesItAtTheBorder) {
     const Vec2 truth = p.centre(nsToSeconds(q.t_ns));
     EXPECT_LE((q.uv - truth).cwiseAbs().maxCoeff(), o.step_px + 0.5) << "point " << i;
   }
+  // At most one point per window span: N − 1 = 192 intervals of ≥ 20 µs.
+  for (std::size_t i = 2; i + 1 < points.size(); ++i)
+    EXPECT_GE(points[i].t_ns - points[i - 1].t_ns, 192 * 20000) << "point " << i;
   const TrackPoint& last = points[points.size() - 2];
   EXPECT_EQ(points.back().uv, last.uv);  // kLost repeats the last good point
   EXPECT_GE(last.uv.x(), kWidth - 1 - o.lost_border_px - o.step_px);
   EXPECT_LE(last.uv.x(), kWidth - 1 - o.lost_border_px);
+}
+
+// With one_point_per_window off, every state jump is a track point.
+TEST(HasteTracker, EveryJumpIsAPointWhenNotThrottled) {
+  DotPattern p = DotPattern::random(9, 40, 11.0);
+  p.c0 = Vec2(60.0, 60.0);
+  p.velocity_px_s = Vec2(40.0, 20.0);
+  HasteOptions o;
+  o.one_point_per_window = false;
+  HasteTracker tracker(o, testCamera());
+  tracker.addFeature(p.c0, 0);
+  tracker.addEvents(toArray(patternEvents(p, 0.5, 20e-6, 0.0, 0.0, 6)));
+  TrackPoints points;
+  tracker.drainTrackPoints(points);
+  ASSERT_EQ(tracker.numAlive(), 1u);
+  EXPECT_GT(tracker.counters().jumps, 20u);
+  EXPECT_EQ(points.size(), tracker.counters().jumps + 1);  // + the kNew point
 }
 
 // Seeding on frames: the features start at the Harris corners of the frame

@@ -6,9 +6,9 @@
 /// BMVC 2020) with the defaults of the authors' reference implementation
 /// (github.com/ialzugaray/haste: 31 px patch, window of 193 events = 1 +
 /// 2⌊0.2·31²/2⌋, 11 hypotheses of ±1 px and ±4°, margin 0.05, template
-/// update 0.1) and the variant HASTE-VIO defaults to in the EKLT-VIO
-/// release (the JPL xVIO library: haste_difference_star). Seeding follows
-/// that release too: Harris corners on frames (the same detector as EKLT),
+/// update 0.1) and the variant HASTE-VIO defaults to in the EKLT-VIO code
+/// release (its xVIO library's x/haste/haste_tracker, NASA/JPL 2021:
+/// haste_difference_star). Seeding follows that release too: Harris corners on frames (the same detector as EKLT),
 /// θ = 0, re-detected on a frame when too few features are alive
 /// (docs/algorithms.md#haste).
 

@@ -230,6 +230,13 @@ TEST(HasteOptions, BadValuesNameTheField) {
   EXPECT_THROW(fo.validate(), Error);
   fo.tracker = "haste";
   EXPECT_NO_THROW(fo.validate());
+  fo.haste.margin = 2.0;
+  try {
+    fo.validate();
+    ADD_FAILURE() << "margin 2 accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("haste.margin: must be in [0, 1]", 0), 0u) << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------

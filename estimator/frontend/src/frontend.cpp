@@ -1,21 +1,38 @@
 #include "evio/estimator/frontend/frontend.h"
 
+#include <string>
+
 #include "evio/core/error.h"
 #include "evio/estimator/frontend/eklt_tracker.h"
 #include "evio/estimator/frontend/haste_tracker.h"
 
 namespace evio::estimator {
 
+namespace {
+
+/// Runs a nested validate() and prefixes its message with the section name
+/// ("haste.margin: ...", so a message names the key as it is set).
+template <class Options>
+void validateSection(const char* section, const Options& options) {
+  try {
+    options.validate();
+  } catch (const Error& e) {
+    throw Error(std::string(section) + "." + e.what());
+  }
+}
+
+}  // namespace
+
 void FrontendOptions::validate() const {
   requireField(tracker == "eklt" || tracker == "klt" || tracker == "haste", "tracker",
                "must be eklt, klt or haste (got '" + tracker + "')");
   requireField(image_source == "frames" || image_source == "reconstructed", "image_source",
                "must be frames or reconstructed (got '" + image_source + "')");
-  prefilter.validate();
-  eklt.validate();
-  klt.validate();
-  haste.validate();
-  reconstruction.validate();
+  validateSection("prefilter", prefilter);
+  validateSection("eklt", eklt);
+  validateSection("klt", klt);
+  validateSection("haste", haste);
+  validateSection("reconstruction", reconstruction);
 }
 
 Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C)

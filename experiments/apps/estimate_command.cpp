@@ -1,4 +1,4 @@
-// `evio estimate <sequence> --method eklt-vio|klt-vio|tracks [--config file]
+// `evio estimate <sequence> --method eklt-vio|klt-vio|haste-vio|tracks [--config file]
 //  [--init static|groundtruth] [--set key=value] [--tracks file] [--track-noise px] -o <folder>`: runs an
 // estimator pipeline (estimator/pipeline/pipeline.h) over a sequence folder
 // and writes the estimate folder (trajectory.txt, trajectory_covariance.txt,
@@ -37,8 +37,8 @@ void addEstimateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("estimate", "Run EKLT-VIO, KLT-VIO or the backend on tracks over a sequence");
   cmd->add_option("sequence", args->folder, "sequence folder (Event-Camera Dataset layout)")->required();
   cmd->add_option("--method", args->method,
-                  "eklt-vio, klt-vio or tracks (default: the `method` key of --config/--set)")
-      ->check(CLI::IsMember({"eklt-vio", "klt-vio", "tracks"}));
+                  "eklt-vio, klt-vio, haste-vio or tracks (default: the `method` key of --config/--set)")
+      ->check(CLI::IsMember({"eklt-vio", "klt-vio", "haste-vio", "tracks"}));
   cmd->add_option("--config", args->config,
                   "options YAML (estimator/config/*.yaml; keys: frontend, sync, backend, init, calibration, tracks, "
                   "output)");
@@ -63,7 +63,7 @@ void addEstimateCommand(CLI::App& app) {
     if (args->method.empty()) {
       const YAML::Node m = doc.root.IsMap() ? doc.root["method"] : YAML::Node();
       if (!m.IsDefined() || !m.IsScalar())
-        throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|tracks or method: in " +
+        throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|haste-vio|tracks or method: in " +
                     (args->config.empty() ? std::string("--set") : args->config));
       args->method = config::scalarAs<std::string>(doc, m, "method");
       try {
@@ -80,13 +80,14 @@ void addEstimateCommand(CLI::App& app) {
     config::fill(doc, "", options);
 
     io::StagedFolder out(args->output);  // published whole at the end, or not at all
-    ProgressLine line("estimate", args->method == "eklt-vio" ? "ev" : "s data", args->quiet);
+    const bool event_method = args->method == "eklt-vio" || args->method == "haste-vio";  // progress in events
+    ProgressLine line("estimate", event_method ? "ev" : "s data", args->quiet);
     const auto result = estimator::runPipeline(args->folder, options, out.path(), [&](const auto& p) {
       char label[96];
       std::snprintf(label, sizeof(label), "estimate %s t=%.2f s%s", args->method.c_str(), nsToSeconds(p.t_ns),
                     p.initialized ? "" : " (not initialised)");
       line.setLabel(label);
-      line.update(p.fraction, args->method == "eklt-vio" ? static_cast<double>(p.events) : nsToSeconds(p.t_ns));
+      line.update(p.fraction, event_method ? static_cast<double>(p.events) : nsToSeconds(p.t_ns));
     });
     line.finish();
     // "ok" with no pose at all (no events, never initialised) is no result.

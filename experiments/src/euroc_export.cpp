@@ -114,6 +114,13 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
                                const EurocExportOptions& options) {
   EurocExportSummary summary;
   const fs::path seq(sequence);
+  // A EuRoC sequence is a visual-inertial one: name everything that is missing at once.
+  std::string missing;
+  for (const char* needed : {"sensors.yaml", "images.txt", "imu.txt"})
+    if (!fs::is_regular_file(seq / needed)) missing += std::string(missing.empty() ? "" : ", ") + needed;
+  if (!missing.empty())
+    throw Error(sequence + ": the EuRoC export needs the camera and IMU calibration (sensors.yaml), frames "
+                           "(images.txt) and IMU (imu.txt); missing: " + missing);
   const SensorRig rig = io::readSensorsYaml((seq / "sensors.yaml").string());
   const CameraSensor* cam = options.camera.empty() ? rig.firstCamera(CameraRole::kFrame) : rig.findCamera(options.camera);
   if (!cam && options.camera.empty()) cam = &rig.cameras.front();

@@ -193,6 +193,16 @@ TEST(EurocExport, UsesTheTrueImuStateAndWarnsAboutADroppedK3) {
   EXPECT_EQ(chain["distortion_coeffs"].size(), 4u);
   EXPECT_EQ(chain["resolution"][0].as<int>(), 240);
   EXPECT_THROW(exportEuroc(seq, dir.file("x"), {"nope"}), Error);
+  // A frames-only real recording (no sensors.yaml, no IMU): one error naming both.
+  fs::remove(seq + "/imu.txt");
+  fs::remove(seq + "/sensors.yaml");
+  try {
+    exportEuroc(seq, dir.file("y"));
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing: sensors.yaml, imu.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.file("y")));
 }
 
 /// A matrix given as rows of flow sequences, read as OpenVINS does through cv::FileStorage.

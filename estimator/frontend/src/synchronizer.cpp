@@ -14,6 +14,7 @@ void SynchronizerOptions::validate() const {
   requirePositive("rate_hz", rate_hz);
   requireNonNegative("min_rate_hz", min_rate_hz);
   requireNonNegative("max_extrapolation_s", max_extrapolation_s);
+  requireInRange("min_displacement_px", min_displacement_px, 0.0, 100.0);
 }
 
 Synchronizer::Synchronizer(const SynchronizerOptions& options) : options_(options) {
@@ -36,6 +37,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     if (tr.n > 0 && p.t_ns <= tr.t[1]) {  // same time: replace the newest point; older: ignore
       if (p.t_ns == tr.t[1]) {
         tr.uv[1] = p.uv;
+        tr.cov = p.cov_px;
         tr.moved = true;
       }
       continue;
@@ -44,6 +46,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     tr.uv[0] = tr.uv[1];
     tr.t[1] = p.t_ns;
     tr.uv[1] = p.uv;
+    tr.cov = p.cov_px;
     tr.n = std::min(tr.n + 1, 2);
     tr.moved = true;
     newest = std::max(newest, p.t_ns);
@@ -115,6 +118,13 @@ void Synchronizer::update(TimeNs t_ns) {
     FeatureMeasurement m;
     m.id = id;
     m.uv = extrapolate(tr, t_ns);
+    m.cov_px = tr.cov;
+    m.informative = (!options_.drop_repeated_points || tr.moved) &&
+                    (!tr.informed || (m.uv - tr.last_informative).norm() >= options_.min_displacement_px);
+    if (m.informative) {
+      tr.informed = true;
+      tr.last_informative = m.uv;
+    }
     m.has_previous = tr.sent;
     m.uv_previous = tr.sent ? tr.last_sent : m.uv;
     tr.last_sent = m.uv;

@@ -44,6 +44,18 @@ struct EkltOptions {
   double min_tracking_quality = 0.6;   ///< lost below this 1 − cost/2 (the only outlier test)
   double lost_border_px = 0.0;         ///< lost when the centre comes closer than this to the image edge
 
+  // Measurement covariance (eklt_cost.h ekltPositionCovariance).
+  /// Attach to each track point the covariance of its position from the
+  /// curvature of the cost at the solution (else none: the backend's σ_img).
+  bool position_covariance = true;
+  /// Floor of the position σ along any direction, px: below the sub-pixel
+  /// bias of the event generation model (eklt_tracker.h, 0.04–0.2 px) a
+  /// smaller σ would claim more than the model can give.
+  double position_sigma_min_px = 0.2;
+  /// Cap of the position σ, px: the directions the patch does not constrain
+  /// (along a straight edge) get this σ (the former fixed σ_img, 5 px).
+  double position_sigma_max_px = 5.0;
+
   // Bootstrap (KLT between the detection frame and the next frame).
   int bootstrap_window_px = 20;        ///< Lucas–Kanade window side
   int bootstrap_pyramid_levels = 3;    ///< pyramid levels (OpenCV maxLevel = levels − 1)
@@ -71,6 +83,9 @@ struct EkltOptions {
     v("parameter_tolerance", parameter_tolerance, "relative step that stops the optimiser");
     v("min_tracking_quality", min_tracking_quality, "lost below this tracking quality");
     v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
+    v("position_covariance", position_covariance, "attach the position covariance from the cost curvature");
+    v("position_sigma_min_px", position_sigma_min_px, "floor of the position sigma, px");
+    v("position_sigma_max_px", position_sigma_max_px, "cap of the position sigma, px");
     v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");
     v("bootstrap_pyramid_levels", bootstrap_pyramid_levels, "bootstrap KLT pyramid levels");
     v("imu_prediction", imu_prediction, "predict feature positions from the gyro");

@@ -99,6 +99,35 @@ TEST(Synchronizer, CarriesThePointCovarianceAndFlagsRepeatedOrStillPositions) {
   EXPECT_TRUE(set.features[0].informative);
 }
 
+// A tracker with an exactly known latency τ: its point stamped t shows the
+// true position at t − τ. Compensating τ gives the true position at the set
+// time exactly (linear motion); without it the set trails by v τ.
+TEST(Synchronizer, CompensatesAKnownTrackerLatencyAlongTheTrackVelocity) {
+  const double tau = 0.0015;
+  const Vec2 uv0(40, 30), v(200, -120);  // px, px/s
+  const auto lagged = [&](FeatureId id, double t, TrackStatus st = TrackStatus::kTracked) {
+    return point(id, t, linear(uv0, v, t - tau), st);
+  };
+  SynchronizerOptions o;
+  o.n_e = 10;
+  o.track_latency_s = tau;
+  Synchronizer sync(o);
+  Synchronizer plain(SynchronizerOptions{.n_e = 10});
+  for (Synchronizer* s : {&sync, &plain}) {
+    s->addTrackPoints({lagged(1, 0.010, TrackStatus::kNew), lagged(1, 0.012), lagged(1, 0.014)});
+    s->addEvents(10, secondsToNs(0.014));
+  }
+  MeasurementSet set, set_plain;
+  ASSERT_TRUE(sync.poll(&set));
+  ASSERT_TRUE(plain.poll(&set_plain));
+  EXPECT_EQ(set.t_ns, secondsToNs(0.014));
+  EXPECT_LT((set.features[0].uv - linear(uv0, v, 0.014)).norm(), 1e-9);
+  EXPECT_NEAR((set_plain.features[0].uv - linear(uv0, v, 0.014)).norm(), v.norm() * tau, 1e-9);
+
+  o.track_latency_s = 0.06;  // beyond the range [0, 0.05] s
+  EXPECT_THROW(Synchronizer{o}, Error);
+}
+
 TEST(Synchronizer, UpdateTimeMustBeStrictlyAfterThePreviousAndLostTracksLeave) {
   SynchronizerOptions o;
   o.n_e = 10;

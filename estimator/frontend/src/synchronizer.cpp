@@ -15,10 +15,12 @@ void SynchronizerOptions::validate() const {
   requireNonNegative("min_rate_hz", min_rate_hz);
   requireNonNegative("max_extrapolation_s", max_extrapolation_s);
   requireInRange("min_displacement_px", min_displacement_px, 0.0, 100.0);
+  requireInRange("track_latency_s", track_latency_s, 0.0, 0.05);
 }
 
 Synchronizer::Synchronizer(const SynchronizerOptions& options) : options_(options) {
   options_.validate();
+  latency_ns_ = secondsToNs(options_.track_latency_s);
   trigger_ = options_.trigger == "events"       ? Trigger::kEvents
              : options_.trigger == "fixed_rate" ? Trigger::kFixedRate
                                                 : Trigger::kTrackTime;
@@ -117,7 +119,7 @@ void Synchronizer::update(TimeNs t_ns) {
     Track& tr = tracks_.at(id);
     FeatureMeasurement m;
     m.id = id;
-    m.uv = extrapolate(tr, t_ns);
+    m.uv = extrapolate(tr, t_ns + latency_ns_);
     m.cov_px = tr.cov;
     m.informative = (!options_.drop_repeated_points || tr.moved) &&
                     (!tr.informed || (m.uv - tr.last_informative).norm() >= options_.min_displacement_px);

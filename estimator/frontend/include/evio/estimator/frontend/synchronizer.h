@@ -10,6 +10,8 @@
 ///  - "fixed_rate": every 1/rate_hz seconds of data time.
 ///  - "track_time": whenever the latest track timestamp advances (e.g. KLT,
 ///    whose points all carry frame times: one update per frame).
+/// With track_latency_s = τ > 0 the extrapolation goes to t_s + τ instead:
+/// the latency of the tracker compensated along each track's velocity.
 /// Each feature of a set is flagged informative (measurements.h) unless
 /// drop_repeated_points and it has no new track point since the previous
 /// update, or it moved less than min_displacement_px since its last
@@ -46,6 +48,11 @@ struct SynchronizerOptions {
   /// Mark a feature not informative until its position has moved this far
   /// from its last informative position, px (0: any motion).
   double min_displacement_px = 0.0;
+  /// The tracker's latency τ, s: a track point stamped t shows where the
+  /// feature was at t − τ, so a track is sent at the set time t_s as its
+  /// extrapolation to t_s + τ (from its last two points, the track's
+  /// velocity). 0: the points are taken as stamped.
+  double track_latency_s = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -56,6 +63,7 @@ struct SynchronizerOptions {
     v("max_extrapolation_s", max_extrapolation_s, "extrapolation horizon, s");
     v("drop_repeated_points", drop_repeated_points, "features without a new track point are not informative");
     v("min_displacement_px", min_displacement_px, "motion since the last informative position, px");
+    v("track_latency_s", track_latency_s, "tracker latency compensated along the track's velocity, s");
   }
   void validate() const;
 };
@@ -105,6 +113,7 @@ class Synchronizer {
   bool any_time_ = false;
   TimeNs next_fixed_ns_ = -1;
   TimeNs latest_point_ns_ = 0;
+  TimeNs latency_ns_ = 0;  // track_latency_s
 };
 
 }  // namespace evio::estimator

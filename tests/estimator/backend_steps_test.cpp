@@ -10,6 +10,7 @@
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/aux_updaters.h"
 #include "evio/estimator/backend/feature_selection.h"
+#include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/msckf_updater.h"
 #include "evio/estimator/backend/slam_updater.h"
 #include "evio/estimator/backend/visual_models.h"
@@ -60,13 +61,67 @@ TEST(BackendSteps, UndistortObservationsGivesNormalisedCoordinatesOncePerFeature
   MeasurementSet set;
   set.features = {{1, Vec2(150, 75)}, {2, Vec2(100, 50)}, {1, Vec2(0, 0)}};
   BackendStats stats;
-  const auto obs = undistortObservations(set, kCamera, &stats);
+  const auto obs = undistortObservations(set, kCamera, 0.01, &stats);
   ASSERT_EQ(obs.size(), 2u);
   EXPECT_EQ(obs[0].id, 1);
   EXPECT_TRUE(obs[0].z.isApprox(Vec2(0.5, 0.25)));  // ((150−100)/100, (75−50)/100)
   EXPECT_EQ(obs[1].id, 2);
   EXPECT_TRUE(obs[1].z.isZero(0.0));
   EXPECT_EQ(stats.features_undistort_failed, 0);
+}
+
+// A stated pixel covariance becomes Σ_z = K⁻¹ Σ_px K⁻ᵀ in normalised units
+// and the observation's whitening W satisfies W Σ_z Wᵀ = σ_z² I; no
+// covariance (zero) or one that is not positive definite gives W = I.
+TEST(BackendSteps, UndistortObservationsWhitensAStatedCovarianceToSigmaZ) {
+  const Camera camera(PinholeCamera(200, 100, Vec4(100, 80, 100, 50)));  // fx ≠ fy
+  MeasurementSet set;
+  FeatureMeasurement a, b, c;
+  a.id = 1;
+  a.uv = Vec2(120, 60);
+  a.cov_px << 0.5, 0.2, 0.2, 2.0;
+  b.id = 2;
+  b.uv = Vec2(90, 40);
+  c.id = 3;
+  c.uv = Vec2(80, 30);
+  c.cov_px << 1.0, 2.0, 2.0, 1.0;  // indefinite
+  c.informative = false;
+  set.features = {a, b, c};
+  BackendStats stats;
+  const double sigma_z = 0.05;
+  const auto obs = undistortObservations(set, camera, sigma_z, &stats);
+  ASSERT_EQ(obs.size(), 3u);
+  const Mat2 K_inv = Vec2(1.0 / 100.0, 1.0 / 80.0).asDiagonal();
+  const Mat2 cov_z = K_inv * a.cov_px * K_inv;
+  const Mat2 white = obs[0].whiten * cov_z * obs[0].whiten.transpose();
+  EXPECT_LT((white - sigma_z * sigma_z * Mat2::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(obs[1].whiten, Mat2::Identity());
+  EXPECT_EQ(obs[2].whiten, Mat2::Identity());
+  EXPECT_TRUE(obs[0].informative);
+  EXPECT_FALSE(obs[2].informative);
+}
+
+// A feature flagged not informative keeps its track alive (not lost, not
+// erased) without an observation in this clone, cannot become a SLAM
+// candidate here (its newest observation is older than the anchor would
+// be), and starts no track when it has none.
+TEST(BackendSteps, NonInformativeObservationsKeepTracksAliveWithoutObservations) {
+  FilterState state = restingState(1);
+  TrackMap tracks = tracksOf({track(3, {1, 2, 3, 4})});
+  FeatureObservation stale{3, Vec2(0.1, 0.2)};
+  stale.informative = false;
+  FeatureObservation fresh_stale{8, Vec2::Zero()};
+  fresh_stale.informative = false;
+  extendTracks({stale, fresh_stale}, state, 5, &tracks);
+  ASSERT_EQ(tracks.size(), 1u);
+  EXPECT_EQ(tracks[3].observations.size(), 4u);
+  EXPECT_EQ(tracks[3].seen_clone_id, 5);
+  const MsckfChoice c = chooseMsckfTracks(tracks, 5, 1, false, {}, 3, true);
+  EXPECT_TRUE(c.update.empty());
+  EXPECT_TRUE(c.erase.empty());
+  EXPECT_TRUE(chooseSlamCandidates(tracks, 5, 3, 2).empty());
+  // Not seen at clone 6: lost.
+  EXPECT_EQ(chooseMsckfTracks(tracks, 6, 1, false, {}, 3, true).erase, (std::vector<FeatureId>{3}));
 }
 
 TEST(BackendSteps, ExtendTracksSkipsSlamFeaturesAndStartsNewTracks) {
@@ -227,6 +282,48 @@ TEST(BackendUpdaters, MsckfGivesTwoNMinusThreeRowsAndZeroResidualsForExactObserv
   EXPECT_EQ(msckf.lastCount(), 1);
   EXPECT_EQ(b.stats.msckf_features_used, 1);
   EXPECT_TRUE(tracks[4].observations.empty());
+}
+
+// With per-observation covariances R_i = σ_z² W_i⁻¹ W_i⁻ᵀ and P → 0, the
+// whitened, null-space projected MSCKF residual has squared norm / σ_z²
+// equal to the generalised least-squares statistic over the point,
+//   min_δ (r − H_f δ)ᵀ R⁻¹ (r − H_f δ),
+// computed here without any projection.
+TEST(BackendUpdaters, MsckfWhitenedResidualIsTheGeneralisedLeastSquaresStatistic) {
+  const FilterState state = cloneRow({0.0, 0.25, 0.5, 0.75}, 1e-14);
+  const Vec3 p_W(0.3, 0.1, 1.0);
+  const double sigma_z = 0.01;
+  const std::vector<Mat2> covs = {Vec2(1e-4, 4e-4).asDiagonal(), (Mat2() << 2e-4, 1e-4, 1e-4, 3e-4).finished(),
+                                  Vec2(9e-4, 1e-4).asDiagonal(), 1e-4 * Mat2::Identity()};
+  const std::vector<Vec2> noise = {Vec2(0.01, -0.02), Vec2(-0.015, 0.01), Vec2(0.03, 0.005), Vec2(-0.01, -0.01)};
+  FeatureTrack t;
+  t.id = 4;
+  for (std::size_t i = 0; i < state.clones.size(); ++i) {
+    Vec2 z;
+    ASSERT_TRUE(projectWorldPoint(state.clones[i], p_W, &z));
+    t.observations.push_back({state.clones[i].id, z + noise[i], whiteningFor(covs[i], sigma_z)});
+  }
+  MsckfResidual res;
+  ASSERT_EQ(msckfResidual(state, t, 0.0, TriangulationOptions{}, &res), MsckfOutcome::kOk);
+  ASSERT_EQ(res.r.size(), 5);
+  // The statistic from the stacked, unwhitened model at the same point.
+  const Eigen::Index m = 8;
+  VecX r(m);
+  MatX H_f(m, 3);
+  MatX R_inv = MatX::Zero(m, m);
+  for (std::size_t i = 0; i < state.clones.size(); ++i) {
+    Vec2 zh;
+    Mat23 Hp;
+    ASSERT_TRUE(projectWorldPoint(state.clones[i], res.p_W, &zh, nullptr, &Hp));
+    const Eigen::Index row = 2 * static_cast<Eigen::Index>(i);
+    r.segment<2>(row) = t.observations[i].z - zh;
+    H_f.middleRows<2>(row) = Hp;
+    R_inv.block<2, 2>(row, row) = covs[i].inverse();
+  }
+  const Mat3 A = H_f.transpose() * R_inv * H_f;
+  const double gls = r.dot(R_inv * r) - (H_f.transpose() * R_inv * r).dot(A.ldlt().solve(H_f.transpose() * R_inv * r));
+  EXPECT_NEAR(res.r.squaredNorm() / (sigma_z * sigma_z), gls, 1e-6 * gls);
+  EXPECT_GT(gls, 1.0);
 }
 
 TEST(BackendUpdaters, SlamGateAcceptsThePredictionAndGatesOutRepeatedOutliers) {

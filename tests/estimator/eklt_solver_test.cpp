@@ -155,6 +155,84 @@ TEST(EkltCost, FeaturePositionInvertsTheWarp) {
   EXPECT_NEAR((Vec2(cs * u.x() - sn * u.y(), sn * u.x() + cs * u.y()) + Vec2(p[1], p[2]) - x0).norm(), 0.0, 1e-12);
 }
 
+// A straight vertical edge: the template gradient is (γ(x), 0) with γ a
+// Gaussian profile in x, the warp the identity at the template point, the
+// measured batch the predicted increment plus a checkerboard perturbation
+// (even in both patch axes, so p stays the minimum). Then J has only the
+// θ and tx columns, uncoupled, and on integer samples the Catmull-Rom
+// derivative is the central difference, so
+//   (JᵀJ)_tx = Σ_j γ'(j)² / Σ_j γ(j)²,   γ'(j) = (γ(j+1) − γ(j−1))/2,
+// (the rows repeat; the normalisation term vanishes as γ is even and γ' odd)
+// and the position covariance is diag(1/((JᵀJ)_tx/σ_r² + 1/σ_max²), σ_max²):
+// across the edge the analytic curvature, along it the cap.
+TEST(EkltCost, PositionCovarianceOfAStraightEdgeIsTheCurvatureAcrossAndTheCapAlong) {
+  const int size = 61;
+  const double width = 2.0;
+  const double centre = 30.0;
+  const auto profile = [&](int x) {
+    return static_cast<float>(std::exp(-0.5 * (x - centre) * (x - centre) / (width * width)));
+  };
+  cv::Mat gx(size, size, CV_32FC1), gy(size, size, CV_32FC1, cv::Scalar(0.0f));
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) gx.at<float>(y, x) = profile(x);
+  GradientTemplate templ;
+  const Vec2 x0(centre, centre);
+  templ.assign(gx, gy, x0, 20);
+
+  const int h = (kP - 1) / 2;
+  const double eps = 0.02;
+  std::vector<double> raw(kN);
+  double n2 = 0.0;
+  for (int i = 0; i < kP; ++i)
+    for (int j = 0; j < kP; ++j) {
+      const double predicted = -static_cast<double>(profile(static_cast<int>(centre) + j - h));
+      raw[static_cast<std::size_t>(i * kP + j)] = predicted + eps * (((i + j) % 2 == 0) ? 1.0 : -1.0);
+      n2 += raw[static_cast<std::size_t>(i * kP + j)] * raw[static_cast<std::size_t>(i * kP + j)];
+    }
+  std::vector<float> m(kN);
+  for (int k = 0; k < kN; ++k) m[static_cast<std::size_t>(k)] = static_cast<float>(raw[static_cast<std::size_t>(k)] / std::sqrt(n2));
+
+  const EkltBatch batch{&templ, m.data(), kP};
+  const Vec4 p(0.0, x0.x(), x0.y(), 0.0);
+  EkltEvaluation e;
+  ASSERT_TRUE(evaluateEklt(batch, p, true, &e));
+  ASSERT_LT(e.jtr.cwiseAbs().maxCoeff(), 1e-9) << "p is not a stationary point";
+  ASSERT_GT(e.cost, 1e-5) << "the perturbation must leave a residual";
+
+  double sum_g2 = 0.0, sum_dg2 = 0.0;
+  for (int j = -h; j <= h; ++j) {
+    const int x = static_cast<int>(centre) + j;
+    const double g = profile(x);
+    const double dg = 0.5 * (static_cast<double>(profile(x + 1)) - static_cast<double>(profile(x - 1)));
+    sum_g2 += g * g;
+    sum_dg2 += dg * dg;
+  }
+  const double curvature = sum_dg2 / sum_g2;
+  EXPECT_NEAR(e.jtj(1, 1), curvature, 1e-6 * curvature);
+  EXPECT_NEAR(e.jtj(2, 2), 0.0, 1e-12);
+
+  const double sigma_r2 = 2.0 * e.cost / (kN - 4.0);
+  const double sigma_max = 5.0;
+  const Mat2 cov = ekltPositionCovariance(e, p, x0, kP, 0.001, sigma_max);
+  const double across = 1.0 / (curvature / sigma_r2 + 1.0 / (sigma_max * sigma_max));
+  EXPECT_NEAR(cov(0, 0), across, 1e-6 * across);
+  EXPECT_NEAR(cov(1, 1), sigma_max * sigma_max, 1e-9);
+  EXPECT_NEAR(cov(0, 1), 0.0, 1e-9);
+  EXPECT_LT(std::sqrt(cov(0, 0)), 0.5) << "a sharp edge locates the feature to a fraction of a pixel across it";
+
+  // The floor and the cap bound both directions.
+  const Mat2 floored = ekltPositionCovariance(e, p, x0, kP, 1.0, 2.0);
+  EXPECT_NEAR(floored(0, 0), 1.0, 1e-9);
+  EXPECT_NEAR(floored(1, 1), 4.0, 1e-9);
+
+  // More residual (a noisier batch) means a proportionally larger variance.
+  EkltEvaluation noisier = e;
+  noisier.cost = 4.0 * e.cost;
+  const Mat2 cov4 = ekltPositionCovariance(noisier, p, x0, kP, 0.001, 1e3);
+  const Mat2 cov1 = ekltPositionCovariance(e, p, x0, kP, 0.001, 1e3);
+  EXPECT_NEAR(cov4(0, 0) / cov1(0, 0), 4.0, 1e-3);
+}
+
 // The hand-written LM and the Ceres reference reach the same solutions on
 // the same batches (within 0.01 px in feature position).
 TEST(EkltSolver, LevenbergMarquardtAgreesWithCeres) {

@@ -50,6 +50,84 @@ TEST(Synchronizer, EveryNeEventsExtrapolatesLinearlyToTheLatestTrackTime) {
   EXPECT_LT((set.features[1].uv_previous - linear(b0, vb, 0.05)).norm(), 1e-9);
 }
 
+// The covariance a tracker states for a point goes with it into every set
+// until a newer point replaces it; repeats of an old point and positions
+// closer than min_displacement_px to the last informative one are flagged
+// not informative.
+TEST(Synchronizer, CarriesThePointCovarianceAndFlagsRepeatedOrStillPositions) {
+  SynchronizerOptions o;
+  o.n_e = 10;
+  o.drop_repeated_points = true;
+  o.min_displacement_px = 1.0;
+  Synchronizer sync(o);
+  TrackPoint a = point(1, 0.00, Vec2(10, 10), TrackStatus::kNew);
+  TrackPoint b = point(2, 0.00, Vec2(50, 50), TrackStatus::kNew);
+  a.cov_px << 0.04, 0.01, 0.01, 0.09;
+  sync.addTrackPoints({a, b});
+  sync.addEvents(10, secondsToNs(0.0));
+  MeasurementSet set;
+  ASSERT_TRUE(sync.poll(&set));
+  ASSERT_EQ(set.features.size(), 2u);
+  EXPECT_EQ(set.features[0].cov_px, a.cov_px);
+  EXPECT_EQ(set.features[1].cov_px, Mat2::Zero());  // not stated
+  EXPECT_TRUE(set.features[0].informative);
+  EXPECT_TRUE(set.features[1].informative);
+
+  // Track 1 moves 0.5 px (below the threshold), track 2 has no new point.
+  TrackPoint a2 = point(1, 0.01, Vec2(10.5, 10));
+  a2.cov_px = 4.0 * Mat2::Identity();
+  sync.addTrackPoints({a2});
+  sync.addEvents(10, secondsToNs(0.01));
+  ASSERT_TRUE(sync.poll(&set));
+  EXPECT_EQ(set.features[0].cov_px, a2.cov_px);
+  EXPECT_FALSE(set.features[0].informative);  // 0.5 px < 1 px
+  EXPECT_FALSE(set.features[1].informative);  // a repeat of the point at 0 s
+
+  // Track 1 reaches 1.2 px from its last informative position (10, 10).
+  sync.addTrackPoints({point(1, 0.02, Vec2(11.2, 10)), point(2, 0.02, Vec2(50.2, 50))});
+  sync.addEvents(10, secondsToNs(0.02));
+  ASSERT_TRUE(sync.poll(&set));
+  EXPECT_TRUE(set.features[0].informative);
+  EXPECT_FALSE(set.features[1].informative);  // new point, but 0.2 px from (50, 50)
+
+  // By default every position is informative, as before.
+  Synchronizer plain{SynchronizerOptions{}};
+  plain.addTrackPoints({point(1, 0.0, Vec2(1, 1), TrackStatus::kNew)});
+  plain.addEvents(3200, secondsToNs(0.0));
+  plain.addEvents(3200, secondsToNs(0.01));
+  ASSERT_TRUE(plain.poll(&set));
+  EXPECT_TRUE(set.features[0].informative);
+}
+
+// A tracker with an exactly known latency τ: its point stamped t shows the
+// true position at t − τ. Compensating τ gives the true position at the set
+// time exactly (linear motion); without it the set trails by v τ.
+TEST(Synchronizer, CompensatesAKnownTrackerLatencyAlongTheTrackVelocity) {
+  const double tau = 0.0015;
+  const Vec2 uv0(40, 30), v(200, -120);  // px, px/s
+  const auto lagged = [&](FeatureId id, double t, TrackStatus st = TrackStatus::kTracked) {
+    return point(id, t, linear(uv0, v, t - tau), st);
+  };
+  SynchronizerOptions o;
+  o.n_e = 10;
+  o.track_latency_s = tau;
+  Synchronizer sync(o);
+  Synchronizer plain(SynchronizerOptions{.n_e = 10});
+  for (Synchronizer* s : {&sync, &plain}) {
+    s->addTrackPoints({lagged(1, 0.010, TrackStatus::kNew), lagged(1, 0.012), lagged(1, 0.014)});
+    s->addEvents(10, secondsToNs(0.014));
+  }
+  MeasurementSet set, set_plain;
+  ASSERT_TRUE(sync.poll(&set));
+  ASSERT_TRUE(plain.poll(&set_plain));
+  EXPECT_EQ(set.t_ns, secondsToNs(0.014));
+  EXPECT_LT((set.features[0].uv - linear(uv0, v, 0.014)).norm(), 1e-9);
+  EXPECT_NEAR((set_plain.features[0].uv - linear(uv0, v, 0.014)).norm(), v.norm() * tau, 1e-9);
+
+  o.track_latency_s = 0.06;  // beyond the range [0, 0.05] s
+  EXPECT_THROW(Synchronizer{o}, Error);
+}
+
 TEST(Synchronizer, UpdateTimeMustBeStrictlyAfterThePreviousAndLostTracksLeave) {
   SynchronizerOptions o;
   o.n_e = 10;
@@ -125,6 +203,9 @@ TEST(Synchronizer, RejectsBadOptions) {
   EXPECT_THROW(Synchronizer{o}, Error);
   o = SynchronizerOptions{};
   o.n_e = 0;
+  EXPECT_THROW(Synchronizer{o}, Error);
+  o = SynchronizerOptions{};
+  o.min_displacement_px = -0.1;
   EXPECT_THROW(Synchronizer{o}, Error);
 }
 

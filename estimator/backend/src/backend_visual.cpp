@@ -17,7 +17,7 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
   const std::size_t c = state_.clones.size() - 1;
   const std::int64_t clone_id = state_.clones[c].id;
 
-  const std::vector<FeatureObservation> observations = undistortObservations(set, sensors_.camera, &stats_);
+  const std::vector<FeatureObservation> observations = undistortObservations(set, sensors_.camera, sigma_z_, &stats_);
   slam_.marginalizeUnobserved(observations);
   const SlamGate slam_gate = slam_.gate(observations, c);
   extendTracks(observations, state_, clone_id, &tracks_);

@@ -3,16 +3,35 @@
 #include <algorithm>
 #include <utility>
 
+#include <Eigen/Cholesky>
+
 namespace evio::estimator {
 
 namespace {
-bool isLive(const FeatureTrack& track, std::int64_t clone_id) {
+/// Observed in clone `clone_id`.
+bool isObservedIn(const FeatureTrack& track, std::int64_t clone_id) {
   return !track.observations.empty() && track.observations.back().clone_id == clone_id;
+}
+/// In the measurement set of clone `clone_id` (observed or not informative).
+bool isLive(const FeatureTrack& track, std::int64_t clone_id) {
+  return isObservedIn(track, clone_id) || track.seen_clone_id == clone_id;
 }
 }  // namespace
 
+Mat2 whiteningFor(const Mat2& cov_z, double sigma_z) {
+  if (!cov_z.allFinite() || !(cov_z.trace() > 0.0)) return Mat2::Identity();
+  const Eigen::LLT<Mat2> llt(0.5 * (cov_z + cov_z.transpose()));
+  if (llt.info() != Eigen::Success) return Mat2::Identity();
+  const Mat2 L = llt.matrixL();
+  if (!(L(0, 0) > 0.0) || !(L(1, 1) > 0.0)) return Mat2::Identity();
+  const Mat2 W = sigma_z * L.inverse();
+  return W.allFinite() ? W : Mat2::Identity();
+}
+
 std::vector<FeatureObservation> undistortObservations(const MeasurementSet& set, const Camera& camera,
-                                                      BackendStats* stats) {
+                                                      double sigma_z, BackendStats* stats) {
+  const Vec4 k = camera.intrinsics();
+  const Mat2 K_inv = Vec2(1.0 / k(0), 1.0 / k(1)).asDiagonal();
   std::vector<FeatureObservation> out;
   out.reserve(set.features.size());
   std::unordered_set<FeatureId> seen;
@@ -23,7 +42,9 @@ std::vector<FeatureObservation> undistortObservations(const MeasurementSet& set,
       ++stats->features_undistort_failed;
       continue;
     }
-    out.push_back({m.id, bearing.head<2>() / bearing.z()});
+    const bool stated = m.cov_px != Mat2::Zero();
+    out.push_back({m.id, bearing.head<2>() / bearing.z(),
+                   stated ? whiteningFor(K_inv * m.cov_px * K_inv, sigma_z) : Mat2::Identity(), m.informative});
   }
   return out;
 }
@@ -32,9 +53,11 @@ void extendTracks(const std::vector<FeatureObservation>& observations, const Fil
                   std::int64_t clone_id, TrackMap* tracks) {
   for (const FeatureObservation& o : observations) {
     if (state.findFeature(o.id) >= 0) continue;
+    if (!o.informative && tracks->count(o.id) == 0) continue;  // a track starts at an informative position
     FeatureTrack& track = (*tracks)[o.id];
     track.id = o.id;
-    track.observations.push_back({clone_id, o.z});
+    track.seen_clone_id = clone_id;
+    if (o.informative) track.observations.push_back({clone_id, o.z, o.whiten});
   }
 }
 
@@ -44,7 +67,7 @@ std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, std::int64_t
   if (free_slots <= 0) return out;
   std::vector<std::pair<std::size_t, FeatureId>> eligible;  // (length, id)
   for (const auto& [id, track] : tracks)
-    if (isLive(track, clone_id) && static_cast<int>(track.observations.size()) >= min_length)
+    if (isObservedIn(track, clone_id) && static_cast<int>(track.observations.size()) >= min_length)
       eligible.emplace_back(track.observations.size(), id);
   std::sort(eligible.begin(), eligible.end(),
             [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });

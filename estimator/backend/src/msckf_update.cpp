@@ -6,16 +6,18 @@
 namespace evio::estimator {
 
 void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vector<CameraClone>* clones,
-                 std::vector<std::size_t>* clone_positions, std::vector<Vec2>* z) {
+                 std::vector<std::size_t>* clone_positions, std::vector<Vec2>* z, std::vector<Mat2>* whiten) {
   clones->clear();
   clone_positions->clear();
   z->clear();
+  if (whiten != nullptr) whiten->clear();
   for (const TrackObservation& o : track.observations) {
     const int i = state.findClone(o.clone_id);
     if (i < 0) continue;
     clones->push_back(state.clones[static_cast<std::size_t>(i)]);
     clone_positions->push_back(static_cast<std::size_t>(i));
     z->push_back(o.z);
+    if (whiten != nullptr) whiten->push_back(o.whiten);
   }
 }
 
@@ -24,7 +26,8 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
   std::vector<CameraClone> clones;
   std::vector<std::size_t> pos;
   std::vector<Vec2> z;
-  gatherTrack(state, track, &clones, &pos, &z);
+  std::vector<Mat2> W;
+  gatherTrack(state, track, &clones, &pos, &z, &W);
   const std::size_t n = clones.size();
   if (n < 2) return MsckfOutcome::kTooShort;
   if (rotationCompensatedDisparity(clones, z) < min_parallax) return MsckfOutcome::kNoParallax;
@@ -40,10 +43,11 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
     Mat26 Hc;
     Mat23 Hp;
     if (!projectWorldPoint(clones[i], tri.p_W, &zh, &Hc, &Hp)) return MsckfOutcome::kProjectionFailed;
+    // Whitened rows W (z − ẑ) ≈ W H δx + W n, W n ~ N(0, σ_z² I) (feature_track.h).
     const Eigen::Index row = 2 * static_cast<Eigen::Index>(i);
-    r.segment<2>(row) = z[i] - zh;
-    H_x.block<2, 6>(row, state.cloneIndex(pos[i])) = Hc;
-    H_f.block<2, 3>(row, 0) = Hp;
+    r.segment<2>(row) = W[i] * (z[i] - zh);
+    H_x.block<2, 6>(row, state.cloneIndex(pos[i])) = W[i] * Hc;
+    H_f.block<2, 3>(row, 0) = W[i] * Hp;
   }
   if (m <= 3) return MsckfOutcome::kTooShort;
   projectOnLeftNullSpace(H_f, &H_x, &r);

@@ -26,12 +26,16 @@ bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const 
 }
 
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
-                             double sigma_rho0, double sigma_z) {
+                             double sigma_rho0, double sigma_z, const Mat2& whiten) {
   SlamFeature f;
   f.id = id;
   f.anchor_clone_id = state.clones[c].id;
   f.abr = Vec3(z.x(), z.y(), rho0);
-  const Mat3 P_ff = Vec3(sigma_z * sigma_z, sigma_z * sigma_z, sigma_rho0 * sigma_rho0).asDiagonal();
+  // (α, β) = z: the observation's covariance Σ_z = σ_z² W⁻¹ W⁻ᵀ (feature_track.h).
+  const Mat2 W_inv = whiten.inverse();
+  Mat3 P_ff = Mat3::Zero();
+  P_ff.topLeftCorner<2, 2>() = sigma_z * sigma_z * W_inv * W_inv.transpose();
+  P_ff(2, 2) = sigma_rho0 * sigma_rho0;
   state.addFeature(f, P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim()));
 }
 
@@ -60,7 +64,9 @@ bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, 
     H_x.block<2, 6>(row, state.cloneIndex(static_cast<std::size_t>(a))) += Ha;
     H_x.block<2, 6>(row, state.cloneIndex(c)) += Hc;
     H_f.block<2, 3>(row, 0) = Hf;
-    r.segment<2>(row) = obs[i]->z - zh;
+    r.segment<2>(row) = obs[i]->whiten * (obs[i]->z - zh);  // whitened to σ_z² I (feature_track.h)
+    H_x.middleRows<2>(row) = obs[i]->whiten * H_x.middleRows<2>(row);
+    H_f.middleRows<2>(row) = obs[i]->whiten * H_f.middleRows<2>(row);
   }
   if (constrain) constrain(&H_x);
   const Eigen::HouseholderQR<MatX> qr(H_f);

@@ -25,6 +25,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
   SlamGate out;
   const double sigma2 = sigma_z_ * sigma_z_;
   for (const FeatureObservation& o : observations) {
+    if (!o.informative) continue;  // alive (marginalizeUnobserved saw it), not observed
     const int j = state().findFeature(o.id);
     if (j < 0) continue;
     const auto jj = static_cast<std::size_t>(j);
@@ -33,6 +34,8 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     MatX Hc;
     const bool ok = slamResidual(state(), jj, c, o.z, &H, &r);
     if (ok) {
+      H = o.whiten * H;  // whitened to σ_z² I (feature_track.h)
+      r = o.whiten * r;
       Hc = H;
       constrain(&Hc);
     }
@@ -58,8 +61,8 @@ void SlamUpdater::relinearize(const FilterState& x, const std::vector<FeatureObs
     Vec2 rq;
     const int j = x.findFeature(accepted[q].id);
     if (j < 0 || !slamResidual(x, static_cast<std::size_t>(j), c, accepted[q].z, &Hq, &rq)) continue;
-    H->middleRows<2>(2 * static_cast<Eigen::Index>(q)) = Hq;
-    r->segment<2>(2 * static_cast<Eigen::Index>(q)) = rq;
+    H->middleRows<2>(2 * static_cast<Eigen::Index>(q)) = accepted[q].whiten * Hq;
+    r->segment<2>(2 * static_cast<Eigen::Index>(q)) = accepted[q].whiten * rq;
   }
   constrain(H);
 }
@@ -106,15 +109,16 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, bool* done) 
 
 void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c) {
   const Vec2& z = track.observations.back().z;
+  const Mat2& W = track.observations.back().whiten;
   if (const auto rho = rangeDepthPrior(state().clones[c], z)) {
-    addSlamFeatureWithPrior(state(), track.id, c, z, *rho, options().range_prior_relative_sigma * *rho, sigma_z_);
+    addSlamFeatureWithPrior(state(), track.id, c, z, *rho, options().range_prior_relative_sigma * *rho, sigma_z_, W);
     ++stats().slam_initialized_range;
     return;
   }
   // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min).
   const double rho0 = 1.0 / (2.0 * options().slam_min_depth_m);
   const double sigma_rho0 = 1.0 / (4.0 * options().slam_min_depth_m);
-  addSlamFeatureWithPrior(state(), track.id, c, z, rho0, sigma_rho0, sigma_z_);
+  addSlamFeatureWithPrior(state(), track.id, c, z, rho0, sigma_rho0, sigma_z_, W);
   ++stats().slam_initialized_prior;
 }
 

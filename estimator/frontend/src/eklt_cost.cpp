@@ -2,7 +2,11 @@
 
 #include "evio/core/cpu_features.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -284,6 +288,31 @@ Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const V
   const double s = std::sin(p[0]);
   const Vec2 d = x0 - Vec2(p[1], p[2]);
   return accumulation_centre + Vec2(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+}
+
+Mat2 ekltPositionCovariance(const EkltEvaluation& eval, const Vec4& p, const Vec2& x0, int patch_size,
+                            double sigma_min_px, double sigma_max_px) {
+  const double dof = static_cast<double>(patch_size) * patch_size - 4.0;
+  // A perfect fit (cost 0) would claim zero noise: the floor σ_min takes over below.
+  const double sigma_r2 = std::max(2.0 * eval.cost / dof, 1e-300);
+  Mat4 info = eval.jtj / sigma_r2;
+  const double prior_angle = 1.0 / (M_PI * M_PI);
+  const double prior_t = 1.0 / (sigma_max_px * sigma_max_px);
+  info.diagonal() += Vec4(prior_angle, prior_t, prior_t, prior_angle);
+  const Mat4 cov_p = info.ldlt().solve(Mat4::Identity());
+  // c = c_acc + R(θ)ᵀ d, d = x0 − t:  ∂c/∂θ = (∂Rᵀ/∂θ) d,  ∂c/∂t = −Rᵀ.
+  const double c = std::cos(p[0]);
+  const double s = std::sin(p[0]);
+  const Vec2 d = x0 - Vec2(p[1], p[2]);
+  Eigen::Matrix<double, 2, 4> G = Eigen::Matrix<double, 2, 4>::Zero();
+  G.col(0) = Vec2(-s * d.x() + c * d.y(), -c * d.x() - s * d.y());
+  G.block<2, 2>(0, 1) << -c, -s, s, -c;
+  const Mat2 cov = G * cov_p * G.transpose();
+  const Eigen::SelfAdjointEigenSolver<Mat2> eig(0.5 * (cov + cov.transpose()));
+  if (eig.info() != Eigen::Success || !eig.eigenvalues().allFinite())
+    return Mat2::Identity() * sigma_max_px * sigma_max_px;
+  const Vec2 lambda = eig.eigenvalues().cwiseMax(sigma_min_px * sigma_min_px).cwiseMin(sigma_max_px * sigma_max_px);
+  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
 }
 
 }  // namespace evio::estimator

@@ -95,10 +95,11 @@ EkltSolution solveEkltCeres(const EkltBatch& batch, const Vec4& p0, const EkltSo
   sol.p = Vec4(params[0], params[1], params[2], params[3]);
   sol.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
   EkltEvaluation eval;
-  sol.valid = summary.IsSolutionUsable() && evaluateEklt(batch, sol.p, false, &eval);
+  sol.valid = summary.IsSolutionUsable() && evaluateEklt(batch, sol.p, true, &eval);
   if (sol.valid) {
     sol.cost = eval.cost;
     sol.abs_sum = eval.abs_sum;
+    sol.jtj = eval.jtj;
   }
   return sol;
 }

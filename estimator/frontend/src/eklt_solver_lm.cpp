@@ -62,6 +62,7 @@ EkltSolution solveEkltLm(const EkltBatch& batch, const Vec4& p0, const EkltSolve
   }
   sol.cost = cur.cost;
   sol.abs_sum = cur.abs_sum;
+  sol.jtj = cur.jtj;
   return sol;
 }
 

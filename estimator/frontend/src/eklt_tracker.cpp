@@ -40,6 +40,9 @@ void EkltOptions::validate() const {
   requireNonNegative("parameter_tolerance", parameter_tolerance);
   requireInRange("min_tracking_quality", min_tracking_quality, 0.0, 1.0);
   requireNonNegative("lost_border_px", lost_border_px);
+  requireInRange("position_sigma_min_px", position_sigma_min_px, 1e-3, 100.0);
+  requireField(position_sigma_max_px >= position_sigma_min_px && position_sigma_max_px <= 100.0,
+               "position_sigma_max_px", "must be in [position_sigma_min_px, 100]");
   requireField(bootstrap_window_px >= 3, "bootstrap_window_px", "must be >= 3");
   requireField(bootstrap_pyramid_levels >= 1, "bootstrap_pyramid_levels", "must be >= 1");
   requirePositive("log_offset", log_offset);
@@ -302,7 +305,15 @@ void EkltTracker::optimise(int index) {
   s.centre = uv;
   s.t_centre_ns = t_mid;
   s.batch_size = batchSize(sol.abs_sum);
-  out_.push_back(TrackPoint{s.id, t_mid, uv, s.quality, TrackStatus::kTracked});
+  TrackPoint point{s.id, t_mid, uv, s.quality, TrackStatus::kTracked};
+  if (options_.position_covariance) {
+    EkltEvaluation at_solution;
+    at_solution.cost = sol.cost;
+    at_solution.jtj = sol.jtj;
+    point.cov_px = ekltPositionCovariance(at_solution, sol.p, s.x0, options_.patch_size_px,
+                                          options_.position_sigma_min_px, options_.position_sigma_max_px);
+  }
+  out_.push_back(point);
   resetPatch(s);
   const PixelRect rect = patchRect(uv);
   if (rect.x0 != s.rect.x0 || rect.y0 != s.rect.y0 || rect.x1 != s.rect.x1 || rect.y1 != s.rect.y1) {

@@ -14,10 +14,13 @@ void SynchronizerOptions::validate() const {
   requirePositive("rate_hz", rate_hz);
   requireNonNegative("min_rate_hz", min_rate_hz);
   requireNonNegative("max_extrapolation_s", max_extrapolation_s);
+  requireInRange("min_displacement_px", min_displacement_px, 0.0, 100.0);
+  requireInRange("track_latency_s", track_latency_s, 0.0, 0.05);
 }
 
 Synchronizer::Synchronizer(const SynchronizerOptions& options) : options_(options) {
   options_.validate();
+  latency_ns_ = secondsToNs(options_.track_latency_s);
   trigger_ = options_.trigger == "events"       ? Trigger::kEvents
              : options_.trigger == "fixed_rate" ? Trigger::kFixedRate
                                                 : Trigger::kTrackTime;
@@ -36,6 +39,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     if (tr.n > 0 && p.t_ns <= tr.t[1]) {  // same time: replace the newest point; older: ignore
       if (p.t_ns == tr.t[1]) {
         tr.uv[1] = p.uv;
+        tr.cov = p.cov_px;
         tr.moved = true;
       }
       continue;
@@ -44,6 +48,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     tr.uv[0] = tr.uv[1];
     tr.t[1] = p.t_ns;
     tr.uv[1] = p.uv;
+    tr.cov = p.cov_px;
     tr.n = std::min(tr.n + 1, 2);
     tr.moved = true;
     newest = std::max(newest, p.t_ns);
@@ -114,7 +119,14 @@ void Synchronizer::update(TimeNs t_ns) {
     Track& tr = tracks_.at(id);
     FeatureMeasurement m;
     m.id = id;
-    m.uv = extrapolate(tr, t_ns);
+    m.uv = extrapolate(tr, t_ns + latency_ns_);
+    m.cov_px = tr.cov;
+    m.informative = (!options_.drop_repeated_points || tr.moved) &&
+                    (!tr.informed || (m.uv - tr.last_informative).norm() >= options_.min_displacement_px);
+    if (m.informative) {
+      tr.informed = true;
+      tr.last_informative = m.uv;
+    }
     m.has_previous = tr.sent;
     m.uv_previous = tr.sent ? tr.last_sent : m.uv;
     tr.last_sent = m.uv;

@@ -43,6 +43,10 @@ struct TrackPoint {
   Vec2 uv = Vec2::Zero();         ///< position in px, distorted image coordinates
   double quality = 1.0;           ///< tracking quality in [0, 1] (EKLT: 1 − cost/2; KLT: 1)
   TrackStatus status = TrackStatus::kTracked;
+  /// Covariance of uv, px² (distorted image axes), as the tracker states it
+  /// (EKLT: from the curvature of its cost, eklt_cost.h). Zero: not stated,
+  /// the backend uses its configured σ_img.
+  Mat2 cov_px = Mat2::Zero();
 };
 
 using TrackPoints = std::vector<TrackPoint>;
@@ -56,6 +60,14 @@ struct FeatureMeasurement {
   Vec2 uv = Vec2::Zero();           ///< at the set's time, px (distorted image)
   Vec2 uv_previous = Vec2::Zero();  ///< as sent at the previous update (= uv when none)
   bool has_previous = false;        ///< false for a track new since the previous update
+  /// Covariance of uv, px²; zero: not stated (the backend's σ_img). The
+  /// covariance of the track point uv comes from (not grown by extrapolation).
+  Mat2 cov_px = Mat2::Zero();
+  /// False when uv repeats what an earlier update already told (no new track
+  /// point, or less motion than the synchroniser's min_displacement_px since
+  /// the last informative position): the backend keeps the feature alive
+  /// but takes no observation of it (docs/algorithms.md#correlated-measurements).
+  bool informative = true;
 };
 
 /// The positions of the live features at one time: one backend update.
@@ -88,7 +100,8 @@ struct ImuState {
 };
 
 /// The innovations of one visual update, for self-diagnosis: every gated
-/// feature's normalised innovation squared rᵀ S⁻¹ r (S = H P Hᵀ + σ² I),
+/// feature's normalised innovation squared rᵀ S⁻¹ r (S = H P Hᵀ + R, R the
+/// measurement covariance: per observation, or σ² I),
 /// summed with its degrees of freedom, whether the gate accepted it or not.
 /// For a consistent filter E[nis] = dof.
 struct InnovationStats {

@@ -22,6 +22,10 @@ namespace evio::estimator {
 struct FeatureObservation {
   FeatureId id = 0;
   Vec2 z = Vec2::Zero();
+  Mat2 whiten = Mat2::Identity();  ///< as TrackObservation::whiten
+  /// FeatureMeasurement::informative: false keeps the feature alive (SLAM
+  /// feature not marginalised, track not lost) without an observation.
+  bool informative = true;
 };
 
 using TrackMap = std::map<FeatureId, FeatureTrack>;
@@ -30,23 +34,32 @@ using TrackMap = std::map<FeatureId, FeatureTrack>;
 /// unprojected bearing, in the set's order; a repeated id keeps its first
 /// measurement; a pixel that does not unproject in front of the camera
 /// (bearing z ≤ 1e-6) is dropped and counted in features_undistort_failed.
+/// A stated pixel covariance Σ_px becomes Σ_z = K⁻¹ Σ_px K⁻ᵀ, K = diag(fx, fy)
+/// (the intrinsics, as σ_img_px / f for σ_z), and the whitening W = σ_z L⁻¹
+/// with L Lᵀ = Σ_z; a covariance that is not positive definite or finite
+/// counts as not stated.
 std::vector<FeatureObservation> undistortObservations(const MeasurementSet& set, const Camera& camera,
-                                                      BackendStats* stats);
+                                                      double sigma_z, BackendStats* stats);
 
-/// Appends clone `clone_id` to the track of every observation that is not a
-/// SLAM feature of `state` (a new id starts a track).
+/// The whitening W = σ_z L⁻¹ (L Lᵀ = Σ_z) of a normalised-coordinate
+/// covariance; identity when Σ_z is not finite and positive definite.
+Mat2 whiteningFor(const Mat2& cov_z, double sigma_z);
+
+/// Appends clone `clone_id` to the track of every informative observation
+/// that is not a SLAM feature of `state` (a new id starts a track), and marks
+/// every observed track seen in clone `clone_id` (alive).
 void extendTracks(const std::vector<FeatureObservation>& observations, const FilterState& state,
                   std::int64_t clone_id, TrackMap* tracks);
 
-/// The tracks that fill `free_slots` free SLAM slots: live ones (observed in
-/// clone `clone_id`) with at least `min_length` observations, longest first,
+/// The tracks that fill `free_slots` free SLAM slots: ones with an
+/// observation in clone `clone_id` with at least `min_length` observations, longest first,
 /// ties by the smaller id.
 std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, std::int64_t clone_id, int free_slots,
                                             int min_length);
 
 struct MsckfChoice {
   std::vector<FeatureId> update;  ///< tracks to use as MSCKF features, in id order
-  std::vector<FeatureId> erase;   ///< lost tracks (not observed in the newest clone), in id order
+  std::vector<FeatureId> erase;   ///< lost tracks (not seen in the newest clone), in id order
 };
 
 /// MSCKF features of this update: tracks about to lose their oldest

@@ -26,9 +26,10 @@ struct MsckfResidual {
 
 /// The clones, their positions in state.clones and the observations of a
 /// track whose clones are still in the window (observations of missing clones
-/// are skipped).
+/// are skipped), and when asked their whitening matrices (feature_track.h).
 void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vector<CameraClone>* clones,
-                 std::vector<std::size_t>* clone_positions, std::vector<Vec2>* z);
+                 std::vector<std::size_t>* clone_positions, std::vector<Vec2>* z,
+                 std::vector<Mat2>* whiten = nullptr);
 
 /// The null-space projected MSCKF residual of `track`. min_parallax is the
 /// rotation-compensated disparity (normalised units) the track must exceed.

@@ -21,11 +21,12 @@ bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const 
                   Eigen::Matrix<double, 2, Eigen::Dynamic>* H, Vec2* r);
 
 /// Depth-prior initialisation (Montiel et al. 2006; xVIO): anchor = clone c,
-/// (α, β) = z, ρ = rho0, with covariance diag(σ_z², σ_z², σ_ρ0²) and zero
+/// (α, β) = z, ρ = rho0, with covariance diag(Σ_z, σ_ρ0²) (Σ_z = σ_z² W⁻¹W⁻ᵀ,
+/// W the observation's whitening, feature_track.h; σ_z² I when W = I) and zero
 /// cross-covariance — the parameters are relative to the anchor clone, whose
 /// own error is in the state, so the new feature is independent of it.
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
-                             double sigma_rho0, double sigma_z);
+                             double sigma_rho0, double sigma_z, const Mat2& whiten = Mat2::Identity());
 
 /// Result of the triangulated initialisation.
 enum class SlamInitOutcome { kOk, kDegenerate, kGateFailed, kUpdateFailed };

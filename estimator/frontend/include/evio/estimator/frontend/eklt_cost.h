@@ -55,6 +55,20 @@ bool ekltResiduals(const EkltBatch& batch, const Vec4& p, VecX* r, MatX* d_r_d_p
 /// sends to the template point x0, c = c_acc + R(θ)ᵀ (x0 − t).
 Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const Vec2& x0);
 
+/// The covariance of the feature position ekltFeaturePosition(p, c_acc, x0)
+/// at a minimum p of the cost (docs/algorithms.md#eklt-measurement-covariance):
+/// the Gauss–Newton (Laplace) covariance of the least-squares estimate,
+///   Σ_p = (JᵀJ / σ_r² + Λ₀)⁻¹,   σ_r² = ‖r‖² / (P² − 4) = 2·cost / (P² − 4),
+/// with Λ₀ = diag(1/π², 1/σ_max², 1/σ_max², 1/π²) a weak prior on (θ, tx, ty, φ)
+/// that bounds the directions the patch does not constrain (along a straight
+/// edge JᵀJ has no curvature: the position is uncertain along the edge up to
+/// σ_max), mapped to the position c = c_acc + R(θ)ᵀ (x0 − t):
+///   Σ_c = G Σ_p Gᵀ,  G = ∂c/∂p = [∂Rᵀ/∂θ (x0 − t), −Rᵀ, 0]   (px²).
+/// Finally each eigenvalue of Σ_c is clamped to [σ_min², σ_max²].
+/// `eval` must hold JᵀJ and the cost at p (evaluateEklt with_jacobian).
+Mat2 ekltPositionCovariance(const EkltEvaluation& eval, const Vec4& p, const Vec2& x0, int patch_size,
+                            double sigma_min_px, double sigma_max_px);
+
 namespace detail {
 /// For tests: does this CPU take the AVX path of the bicubic template
 /// lookup, and the lookup itself (value g and ∂g/∂W at template point W,

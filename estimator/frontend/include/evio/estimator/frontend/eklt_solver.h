@@ -32,6 +32,7 @@ struct EkltSolution {
   Vec4 p = Vec4::Zero();     ///< (θ, tx, ty, φ) at the minimum
   double cost = 0.0;         ///< ½‖r‖² at p
   double abs_sum = 0.0;      ///< Σ|a(u)| at p (eklt_cost.h)
+  Mat4 jtj = Mat4::Zero();   ///< JᵀJ at p (for the position covariance)
   int iterations = 0;        ///< cost evaluations with a Jacobian
   bool valid = false;        ///< false when the cost could not be evaluated
   double quality() const { return 1.0 - 0.5 * cost; }

@@ -10,12 +10,19 @@
 ///  - "fixed_rate": every 1/rate_hz seconds of data time.
 ///  - "track_time": whenever the latest track timestamp advances (e.g. KLT,
 ///    whose points all carry frame times: one update per frame).
+/// With track_latency_s = τ > 0 the extrapolation goes to t_s + τ instead:
+/// the latency of the tracker compensated along each track's velocity.
+/// Each feature of a set is flagged informative (measurements.h) unless
+/// drop_repeated_points and it has no new track point since the previous
+/// update, or it moved less than min_displacement_px since its last
+/// informative position.
 /// Independently, min_rate_hz > 0 forces an update when no update happened
 /// for 1/min_rate_hz seconds of data time (scenes without events).
 /// At an update every live track is linearly extrapolated to the update time
 /// from its last two points (held when it has one; at most
 /// max_extrapolation_s beyond its last point), and carries the position it
-/// was sent with at the previous update.
+/// was sent with at the previous update and the covariance its tracker
+/// stated for its newest point.
 
 #include <cstdint>
 #include <deque>
@@ -34,6 +41,18 @@ struct SynchronizerOptions {
   double rate_hz = 30.0;              ///< update rate ("fixed_rate")
   double min_rate_hz = 0.0;           ///< minimum update rate (0: off)
   double max_extrapolation_s = 0.1;   ///< extrapolation horizon beyond a track's last point
+  /// Mark a feature not informative (measurements.h) when its tracker gave no
+  /// new point since the previous update: the extrapolated repeat of an
+  /// old point carries no new information.
+  bool drop_repeated_points = false;
+  /// Mark a feature not informative until its position has moved this far
+  /// from its last informative position, px (0: any motion).
+  double min_displacement_px = 0.0;
+  /// The tracker's latency τ, s: a track point stamped t shows where the
+  /// feature was at t − τ, so a track is sent at the set time t_s as its
+  /// extrapolation to t_s + τ (from its last two points, the track's
+  /// velocity). 0: the points are taken as stamped.
+  double track_latency_s = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -42,6 +61,9 @@ struct SynchronizerOptions {
     v("rate_hz", rate_hz, "update rate for fixed_rate, Hz");
     v("min_rate_hz", min_rate_hz, "minimum update rate, Hz (0: off)");
     v("max_extrapolation_s", max_extrapolation_s, "extrapolation horizon, s");
+    v("drop_repeated_points", drop_repeated_points, "features without a new track point are not informative");
+    v("min_displacement_px", min_displacement_px, "motion since the last informative position, px");
+    v("track_latency_s", track_latency_s, "tracker latency compensated along the track's velocity, s");
   }
   void validate() const;
 };
@@ -66,6 +88,9 @@ class Synchronizer {
   struct Track {
     TimeNs t[2] = {0, 0};   // last two points, t[1] newest
     Vec2 uv[2] = {Vec2::Zero(), Vec2::Zero()};
+    Mat2 cov = Mat2::Zero();  // of the newest point, px² (zero: not stated)
+    bool informed = false;    // an informative position was sent
+    Vec2 last_informative = Vec2::Zero();
     int n = 0;
     bool moved = true;
     bool sent = false;
@@ -88,6 +113,7 @@ class Synchronizer {
   bool any_time_ = false;
   TimeNs next_fixed_ns_ = -1;
   TimeNs latest_point_ns_ = 0;
+  TimeNs latency_ns_ = 0;  // track_latency_s
 };
 
 }  // namespace evio::estimator

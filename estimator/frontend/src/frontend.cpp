@@ -1,5 +1,7 @@
 #include "evio/estimator/frontend/frontend.h"
 
+#include <string>
+
 #include "evio/core/error.h"
 #include "evio/estimator/frontend/eklt_tracker.h"
 
@@ -9,10 +11,18 @@ void FrontendOptions::validate() const {
   requireField(tracker == "eklt" || tracker == "klt", "tracker", "must be eklt or klt (got '" + tracker + "')");
   requireField(image_source == "frames" || image_source == "reconstructed", "image_source",
                "must be frames or reconstructed (got '" + image_source + "')");
-  prefilter.validate();
-  eklt.validate();
-  klt.validate();
-  reconstruction.validate();
+  // Each section's errors carry its name: eklt.max_features, not max_features.
+  const auto section = [](const char* name, const auto& options) {
+    try {
+      options.validate();
+    } catch (const Error& e) {
+      throw Error(std::string(name) + "." + e.what());
+    }
+  };
+  section("prefilter", prefilter);
+  section("eklt", eklt);
+  section("klt", klt);
+  section("reconstruction", reconstruction);
 }
 
 Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C)

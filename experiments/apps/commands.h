@@ -29,4 +29,8 @@ void addSimulateCommand(CLI::App& app);
 void addEstimateCommand(CLI::App& app);
 void addHealthCommand(CLI::App& app);
 
+/// Every subcommand above, in the order `evio --help` lists them (main.cpp;
+/// the command-line fuzzer, tests/fuzz/fuzz_cli.cpp).
+void addAllCommands(CLI::App& app);
+
 }  // namespace evio::apps

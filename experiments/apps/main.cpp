@@ -23,19 +23,7 @@ int main(int argc, char** argv) {
   CLI::App app{"evio: event-camera visual-inertial odometry test bench (simulate, estimate, evaluate)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", evio::evioVersion());
-  evio::apps::addInfoCommand(app);
-  evio::apps::addStatsCommand(app);
-  evio::apps::addTrajectoryCommand(app);
-  evio::apps::addRenderCommand(app);
-  evio::apps::addTrackCommand(app);
-  evio::apps::addEvaluateTracksCommand(app);
-  evio::apps::addEvaluateCommand(app);
-  evio::apps::addCampaignCommand(app);
-  evio::apps::addReportCommand(app);
-  evio::apps::addExportCommand(app);
-  evio::apps::addSimulateCommand(app);
-  evio::apps::addEstimateCommand(app);
-  evio::apps::addHealthCommand(app);
+  evio::apps::addAllCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

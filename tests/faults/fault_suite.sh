@@ -196,30 +196,60 @@ damage "imu.txt line of 2 MiB" bash -c 'head -c 2097152 /dev/zero | tr "\0" "1" 
 damage "groundtruth time overflows" bash -c 'sed -i "3s/^[^ ]*/9223372037.0/" dmg/groundtruth.txt'
 damage "sensors.yaml symlink loop" bash -c 'rm dmg/sensors.yaml; ln -s sensors.yaml dmg/sensors.yaml'
 
-# ---- campaign: the campaign process killed at seeded times, then resumed ----------------------
+# ---- campaign: the campaign process killed inside its children, then resumed ------------------
 campaign_file="$src/experiments/campaigns/smoke.yaml"
 campaign_set=(--set 'seeds=[1]')
 "$evio" campaign "$campaign_file" -o camp_ref -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1
 rc=$?
 [ "$rc" = 0 ] || [ "$rc" = 3 ] || fail "campaign reference: exit $rc"
+# The kill points: the campaign is killed while its k-th child process (a
+# simulate, estimate or evaluate step; k drawn from the seeded schedule) is
+# running, so every kill lands inside a child's work.
+declare -A kill_in
+child_kind() { # <pid>: simulate | estimate | evaluate | other, from the child's command line
+  local cmd
+  cmd=$(tr '\0' ' ' < "/proc/$1/cmdline" 2> /dev/null)
+  case $cmd in
+    *" trajectory "* | *" simulate "*) echo simulate ;;
+    *evio_fake_estimator* | *" estimate "*) echo estimate ;;
+    *" evaluate "*) echo evaluate ;;
+    *) echo other ;;
+  esac
+}
 for action in INT TERM KILL; do
   for _ in $(seq 1 "$per"); do
-    delay_ms=$((RANDOM % 1500 + 50))
+    k=$((RANDOM % 16 + 1))
     rm -rf camp
     "$evio" campaign "$campaign_file" -o camp -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1 &
     pid=$!
-    sleep "$(printf '0.%03d' "$delay_ms")"
-    kill -s "$action" "$pid" 2> /dev/null
-    wait "$pid"
+    declare -A seen=()
+    kind=none
+    while kill -0 "$pid" 2> /dev/null; do
+      live=$(pgrep -P "$pid")
+      for c in $live; do seen[$c]=1; done
+      if [ "${#seen[@]}" -ge "$k" ] && [ -n "$live" ]; then
+        c=$(echo "$live" | head -1)
+        kind=$(child_kind "$c")
+        kill -s "$action" "$pid" 2> /dev/null
+        break
+      fi
+      sleep 0.005
+    done
+    unset seen
+    wait "$pid" 2> /dev/null
     rc=$?
     injected[campaign]=$((${injected[campaign]:-0} + 1))
-    # Every published job is complete; SIGINT/SIGTERM left no staging.
+    kill_in[$kind]=$((${kill_in[$kind]:-0} + 1))
+    # Every published job is complete; SIGINT/SIGTERM left no staging, in the
+    # job staging area or in the sequence cache (a simulate child's folder).
     for j in camp/jobs/*/; do
       [ -d "$j" ] || continue
-      [ -f "$j/metrics.json" ] && [ -f "$j/job.yaml" ] || fail "campaign $action@${delay_ms}ms: incomplete $(basename "$j")"
+      [ -f "$j/metrics.json" ] && [ -f "$j/job.yaml" ] || fail "campaign $action@child$k: incomplete $(basename "$j")"
     done
     if [ "$action" != KILL ] && [ "$rc" != 0 ] && [ "$rc" != 3 ]; then
-      [ -z "$(ls -A camp/staging 2> /dev/null)" ] || fail "campaign $action@${delay_ms}ms: staging left: $(ls camp/staging)"
+      [ -z "$(ls -A camp/staging 2> /dev/null)" ] || fail "campaign $action@child$k: staging left: $(ls camp/staging)"
+      [ -z "$(leftovers camp/sequences/x)" ] ||
+        fail "campaign $action@child$k: left in the sequence cache: $(leftovers camp/sequences/x | tr '\n' ' ')"
       [ "$rc" = $((128 + $(kill -l "$action"))) ] || fail "campaign $action: exit $rc"
     fi
     if [ "$rc" = 0 ] || [ "$rc" = 3 ]; then outcome_new[campaign]=$((${outcome_new[campaign]:-0} + 1))
@@ -227,15 +257,20 @@ for action in INT TERM KILL; do
     "$evio" campaign "$campaign_file" -o camp -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1
     rc=$?
     { [ "$rc" = 0 ] || [ "$rc" = 3 ]; } || fail "campaign resume after $action: exit $rc"
-    cmp -s camp_ref/summary.csv camp/summary.csv || fail "campaign resume after $action@${delay_ms}ms: summary differs"
+    cmp -s camp_ref/summary.csv camp/summary.csv || fail "campaign resume after $action@child$k: summary differs"
     [ -z "$(ls -A camp/staging)" ] || fail "campaign resume after $action: staging left"
+    [ -z "$(leftovers camp/sequences/x)" ] || fail "campaign resume after $action: left $(leftovers camp/sequences/x)"
   done
 done
+[ "${kill_in[none]:-0}" = 0 ] || fail "campaign: ${kill_in[none]} kills found no child running (the schedule missed)"
+[ "${kill_in[simulate]:-0}" -gt 0 ] || fail "campaign: no kill landed in a simulate child"
 
 echo "fault suite (seed $seed): command: injected faults -> previous output / new output / nothing"
 for c in simulate estimate evaluate campaign read; do
   echo "  $c: ${injected[$c]:-0} -> ${outcome_prev[$c]:-0} / ${outcome_new[$c]:-0} / ${outcome_none[$c]:-0}"
 done
+echo "  campaign kills inside a child: simulate ${kill_in[simulate]:-0}, estimate ${kill_in[estimate]:-0}," \
+  "evaluate ${kill_in[evaluate]:-0}, other ${kill_in[other]:-0}, none ${kill_in[none]:-0}"
 if [ "$failures" -gt 0 ]; then
   echo "fault suite: $failures FAILURES" >&2
   exit 1

@@ -1,8 +1,10 @@
 // libFuzzer target: the HDF5 event reader (DSEC layout). Any input must open
 // and stream or throw evio::Error; nothing else (crash, hang, other exception,
-// an allocation sized by a corrupt header) is acceptable. The seed is a small
-// file written by evio::io::writeEventsH5 (tests/fuzz/seeds/events.h5), so
-// mutations reach the datasets, the attributes and /ms_to_idx.
+// an allocation sized by a corrupt header) is acceptable. Seeds
+// (tests/fuzz/seeds/events_h5/, so mutations reach the datasets, the
+// attributes and /ms_to_idx): 12 events at 1 ms steps in chunks of 4, written
+// by evio::io::writeEventsH5 as uint32 times without checksum, int64 times
+// with Fletcher-32, and gzip level 1 without the sensor-size attributes.
 #include <algorithm>
 
 #include "evio/core/error.h"

@@ -202,40 +202,54 @@ campaign_set=(--set 'seeds=[1]')
 "$evio" campaign "$campaign_file" -o camp_ref -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1
 rc=$?
 [ "$rc" = 0 ] || [ "$rc" = 3 ] || fail "campaign reference: exit $rc"
-# The kill points: the campaign is killed while its k-th child process (a
-# simulate, estimate or evaluate step; k drawn from the seeded schedule) is
-# running, so every kill lands inside a child's work.
+# The kill points: the campaign is killed while its k-th child of one kind
+# runs (a simulate, estimate or evaluate step, the kinds in turn; k drawn from
+# the seeded schedule), so every kill lands inside a child's work. Smoke with
+# one seed runs 2 simulate, 12 estimate and 12 evaluate children.
 declare -A kill_in
-child_kind() { # <pid>: simulate | estimate | evaluate | other, from the child's command line
+child_kind() { # <pid>: simulate | estimate | evaluate | other; "" when it is gone
   local cmd
-  cmd=$(tr '\0' ' ' < "/proc/$1/cmdline" 2> /dev/null)
+  cmd=$(tr '\0' ' ' < "/proc/$1/cmdline" 2> /dev/null) || return 0
   case $cmd in
+    "") ;;
     *" trajectory "* | *" simulate "*) echo simulate ;;
     *evio_fake_estimator* | *" estimate "*) echo estimate ;;
     *" evaluate "*) echo evaluate ;;
     *) echo other ;;
   esac
 }
+kinds=(simulate estimate evaluate)
+point=0
 for action in INT TERM KILL; do
   for _ in $(seq 1 "$per"); do
-    k=$((RANDOM % 16 + 1))
+    want=${kinds[$((point % 3))]}
+    point=$((point + 1))
+    if [ "$want" = simulate ]; then k=$((RANDOM % 2 + 1)); else k=$((RANDOM % 6 + 1)); fi
     rm -rf camp
     "$evio" campaign "$campaign_file" -o camp -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1 &
     pid=$!
-    declare -A seen=()
+    declare -A kind_of_child=()
+    declare -A count=()
     kind=none
     while kill -0 "$pid" 2> /dev/null; do
-      live=$(pgrep -P "$pid")
-      for c in $live; do seen[$c]=1; done
-      if [ "${#seen[@]}" -ge "$k" ] && [ -n "$live" ]; then
-        c=$(echo "$live" | head -1)
-        kind=$(child_kind "$c")
+      hit=""
+      for c in $(pgrep -P "$pid"); do
+        if [ -z "${kind_of_child[$c]:-}" ]; then
+          kc=$(child_kind "$c")
+          [ -n "$kc" ] && [ "$kc" != other ] || continue  # gone, or not yet exec'd
+          kind_of_child[$c]=$kc
+          count[$kc]=$((${count[$kc]:-0} + 1))
+        fi
+        [ "${kind_of_child[$c]}" = "$want" ] && [ "${count[$want]:-0}" -ge "$k" ] && hit=$c
+      done
+      if [ -n "$hit" ]; then
+        kind=$want
         kill -s "$action" "$pid" 2> /dev/null
         break
       fi
-      sleep 0.005
+      sleep 0.002
     done
-    unset seen
+    unset kind_of_child count
     wait "$pid" 2> /dev/null
     rc=$?
     injected[campaign]=$((${injected[campaign]:-0} + 1))
@@ -244,12 +258,12 @@ for action in INT TERM KILL; do
     # job staging area or in the sequence cache (a simulate child's folder).
     for j in camp/jobs/*/; do
       [ -d "$j" ] || continue
-      [ -f "$j/metrics.json" ] && [ -f "$j/job.yaml" ] || fail "campaign $action@child$k: incomplete $(basename "$j")"
+      [ -f "$j/metrics.json" ] && [ -f "$j/job.yaml" ] || fail "campaign $action@$want$k: incomplete $(basename "$j")"
     done
     if [ "$action" != KILL ] && [ "$rc" != 0 ] && [ "$rc" != 3 ]; then
-      [ -z "$(ls -A camp/staging 2> /dev/null)" ] || fail "campaign $action@child$k: staging left: $(ls camp/staging)"
+      [ -z "$(ls -A camp/staging 2> /dev/null)" ] || fail "campaign $action@$want$k: staging left: $(ls camp/staging)"
       [ -z "$(leftovers camp/sequences/x)" ] ||
-        fail "campaign $action@child$k: left in the sequence cache: $(leftovers camp/sequences/x | tr '\n' ' ')"
+        fail "campaign $action@$want$k: left in the sequence cache: $(leftovers camp/sequences/x | tr '\n' ' ')"
       [ "$rc" = $((128 + $(kill -l "$action"))) ] || fail "campaign $action: exit $rc"
     fi
     if [ "$rc" = 0 ] || [ "$rc" = 3 ]; then outcome_new[campaign]=$((${outcome_new[campaign]:-0} + 1))
@@ -257,13 +271,15 @@ for action in INT TERM KILL; do
     "$evio" campaign "$campaign_file" -o camp -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1
     rc=$?
     { [ "$rc" = 0 ] || [ "$rc" = 3 ]; } || fail "campaign resume after $action: exit $rc"
-    cmp -s camp_ref/summary.csv camp/summary.csv || fail "campaign resume after $action@child$k: summary differs"
+    cmp -s camp_ref/summary.csv camp/summary.csv || fail "campaign resume after $action@$want$k: summary differs"
     [ -z "$(ls -A camp/staging)" ] || fail "campaign resume after $action: staging left"
     [ -z "$(leftovers camp/sequences/x)" ] || fail "campaign resume after $action: left $(leftovers camp/sequences/x)"
   done
 done
 [ "${kill_in[none]:-0}" = 0 ] || fail "campaign: ${kill_in[none]} kills found no child running (the schedule missed)"
-[ "${kill_in[simulate]:-0}" -gt 0 ] || fail "campaign: no kill landed in a simulate child"
+for kd in simulate estimate evaluate; do
+  [ "$per" -lt 3 ] || [ "${kill_in[$kd]:-0}" -gt 0 ] || fail "campaign: no kill landed in a $kd child"
+done
 
 echo "fault suite (seed $seed): command: injected faults -> previous output / new output / nothing"
 for c in simulate estimate evaluate campaign read; do

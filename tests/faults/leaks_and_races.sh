@@ -75,13 +75,13 @@ for sig in INT TERM KILL; do
   if ! wait_for 60 exists "res_$sig/sequences/*/*.staging.*"; then
     fail "$sig: the simulate child never started"
     kill -KILL "$pid"
-    wait "$pid"
+    wait "$pid" 2> /dev/null
     continue
   fi
   child_dir=$(compgen -G "res_$sig/sequences/*/*.staging.*" | head -1)
   child=${child_dir##*.}
   kill -s "$sig" "$pid"
-  wait "$pid"
+  wait "$pid" 2> /dev/null
   rc=$?
   [ "$rc" = $((128 + $(kill -l "$sig"))) ] || fail "campaign SIG$sig: exit $rc"
   # The child dies with the campaign (PDEATHSIG).

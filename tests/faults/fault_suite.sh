@@ -208,13 +208,13 @@ rc=$?
 # one seed runs 2 simulate, 12 estimate and 12 evaluate children.
 declare -A kill_in
 child_kind() { # <pid>: simulate | estimate | evaluate | other; "" when it is gone
-  local cmd
-  cmd=$(tr '\0' ' ' < "/proc/$1/cmdline" 2> /dev/null) || return 0
-  case $cmd in
-    "") ;;
-    *" trajectory "* | *" simulate "*) echo simulate ;;
-    *evio_fake_estimator* | *" estimate "*) echo estimate ;;
-    *" evaluate "*) echo evaluate ;;
+  local argv=()
+  mapfile -d '' -t argv < "/proc/$1/cmdline" 2> /dev/null || return 0
+  [ "${#argv[@]}" -gt 0 ] || return 0
+  case "$(basename "${argv[0]}") ${argv[1]:-}" in
+    "evio trajectory" | "evio simulate") echo simulate ;;
+    "evio_fake_estimator "* | "evio estimate") echo estimate ;;
+    "evio evaluate") echo evaluate ;;
     *) echo other ;;
   esac
 }

@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "evio/core/error.h"
+#include "evio/core/io/library_crash_guard.h"
 
 namespace evio::io {
 
@@ -120,8 +121,8 @@ void removeChildStaging(const Slot& slot) {
 
 long threadId() { return ::syscall(SYS_gettid); }
 
-extern "C" void onInterrupt(int sig) {
-  g_interrupted.store(true);
+/// Removes every registered path this thread may remove (system calls only).
+void removeRegisteredPaths() {
   const long self = threadId();
   for (auto& slot : g_slots) {
     int expected = kActive;
@@ -134,9 +135,35 @@ extern "C" void onInterrupt(int sig) {
     removeTreeAt(AT_FDCWD, slot.path, 0);
     if (slot.child_staging) removeChildStaging(slot);
   }
+}
+
+extern "C" void onInterrupt(int sig) {
+  g_interrupted.store(true);
+  removeRegisteredPaths();
   writeAll(sig == SIGINT ? "evio: interrupted (SIGINT); unfinished output removed\n"
                          : "evio: terminated (SIGTERM); unfinished output removed\n");
   ::_exit(128 + sig);
+}
+
+// The file a third-party library is reading on this thread (LibraryCrashGuard).
+thread_local const char* t_crash_library = nullptr;
+thread_local const char* t_crash_file = nullptr;
+
+extern "C" void onLibraryCrash(int sig) {
+  if (t_crash_file == nullptr) {  // not inside a guarded read: the default action
+    ::signal(sig, SIG_DFL);
+    return;  // the faulting instruction runs again and takes it
+  }
+  g_interrupted.store(true);
+  removeRegisteredPaths();
+  writeAll("evio: error: ");
+  writeAll(t_crash_file);
+  writeAll(": the ");
+  writeAll(t_crash_library);
+  writeAll(" library crashed reading this file (");
+  writeAll(sig == SIGFPE ? "SIGFPE" : sig == SIGBUS ? "SIGBUS" : "SIGSEGV");
+  writeAll("); corrupt or hostile file, nothing published\n");
+  ::_exit(1);
 }
 
 bool allDigits(const std::string& s) {
@@ -198,6 +225,22 @@ void installInterruptHandlers() {
   ::sigaction(SIGINT, &sa, nullptr);
   ::sigaction(SIGTERM, &sa, nullptr);
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit fails the write (EFBIG) instead of killing
+  struct sigaction crash {};
+  crash.sa_handler = onLibraryCrash;
+  sigemptyset(&crash.sa_mask);
+  crash.sa_flags = SA_NODEFER;  // SIG_DFL is re-armed inside, and the fault repeats on return
+  for (const int sig : {SIGFPE, SIGSEGV, SIGBUS}) ::sigaction(sig, &crash, nullptr);
+}
+
+LibraryCrashGuard::LibraryCrashGuard(const char* library, const std::string& file)
+    : previous_library_(t_crash_library), previous_file_(t_crash_file), file_(file) {
+  t_crash_library = library;
+  t_crash_file = file_.c_str();
+}
+
+LibraryCrashGuard::~LibraryCrashGuard() {
+  t_crash_file = previous_file_;
+  t_crash_library = previous_library_;
 }
 
 InterruptCleanup::InterruptCleanup(const std::string& path, Scope scope) {

@@ -6,6 +6,7 @@
 #   estimator never includes the simulator side, Embree, OpenEXR or GDAL;
 #   core, trajectories, scenes and the simulator never include the estimator;
 #   core includes no other evio module;
+#   ROS headers appear only in bags/ (which uses core only) and the apps;
 #   inside the estimator, the backend and the frontend never include each
 #   other (nor the pipeline that wires them), and the measurement contract
 #   includes nothing of the estimator: both stand on it.
@@ -28,6 +29,10 @@ check "a lower module includes the estimator or experiments" "core trajectories 
   '#include *[<"]evio/(estimator|experiments)/'
 check "core includes another evio module" "core" \
   '#include *[<"]evio/(trajectories|scenes|simulator)/'
+check "a module below the apps includes ROS or the bags module" "core trajectories scenes simulator estimator experiments/src experiments/include" \
+  '#include *[<"](rosbag/|ros/|sensor_msgs/|geometry_msgs/|std_msgs/|evio/bags/)'
+check "the bags module includes a module other than core" "bags" \
+  '#include *[<"]evio/(trajectories|scenes|simulator|estimator|experiments)/'
 check "trajectories includes scenes or the simulator" "trajectories" \
   '#include *[<"]evio/(scenes|simulator)/'
 check "the backend includes the frontend or the pipeline" "estimator/backend" \

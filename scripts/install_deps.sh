@@ -8,7 +8,12 @@ packages=(
   libeigen3-dev libceres-dev libopencv-dev libembree-dev libtbb-dev
   libopenexr-dev libyaml-cpp-dev libhdf5-dev libcli11-dev libgdal-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
-  python3 python3-matplotlib python3-numpy python3-yaml
+  python3 python3-matplotlib python3-numpy python3-yaml python3-pil
+  python3-dev pybind11-dev
+  dpkg-dev binutils
+  librosbag-storage-dev libroscpp-core-dev libsensor-msgs-dev libgeometry-msgs-dev libstd-msgs-dev
+  python3-rosbag python3-roslz4 python3-genpy python3-genmsg python3-sensor-msgs python3-geometry-msgs
+  python3-std-msgs time
   slurm-wlm munge
 )
 

@@ -10,7 +10,8 @@
 #      (`evio evaluate`, the paper's posyaw alignment on t0+3..8 s),
 #   4. writes the report (`evio report`: Markdown and CSV tables, plots),
 #      plots the sequence (trajectory, a frame with ground-truth tracks and
-#      the events before it) and summarises it with `evio info`,
+#      the events before it), writes its video (`evio video`: frames beside
+#      events, ground-truth tracks) and summarises it with `evio info`,
 #   5. prints the comparison table.
 # Re-running resumes: finished jobs are kept (delete the folder to start over).
 # Usage: scripts/main_job.sh [output-folder]   (default: out/main)
@@ -31,6 +32,8 @@ echo "== report $out/report"
 sequence=$(ls -d "$out"/sequences/mars_yard_circle.*/seed-1 | head -n 1)
 /usr/bin/python3 experiments/plots/plot_trajectory.py "$sequence"
 /usr/bin/python3 experiments/plots/plot_sequence_preview.py "$sequence" --frame 100
+echo "== evio video $sequence -> $out/report/sequence.mp4"
+"$evio" video "$sequence" -o "$out/report/sequence.mp4" --speed 0.5 -q
 echo "== evio info $sequence"
 "$evio" info "$sequence"
 echo

@@ -13,9 +13,11 @@ void addAllCommands(CLI::App& app) {
   addCampaignCommand(app);
   addReportCommand(app);
   addExportCommand(app);
+  addImportCommand(app);
   addSimulateCommand(app);
   addEstimateCommand(app);
   addHealthCommand(app);
+  addVideoCommand(app);
 }
 
 }  // namespace evio::apps

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "data_root.h"
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/stopwatch.h"
@@ -101,7 +102,7 @@ void addCampaignCommand(CLI::App& app) {
   task->add_option("--task", args->task, "array task index (SLURM_ARRAY_TASK_ID)")->required();
 
   collect->callback([args] {
-    const auto campaign = experiments::loadCampaign(args->campaign, args->overrides);
+    const auto campaign = experiments::loadCampaign(resolveDataPath(args->campaign), args->overrides);
     const auto jobs = experiments::expandJobs(campaign);
     const auto r = experiments::collectResults(campaign, jobs, args->results, args->from);
     std::printf("campaign %s: %zu of %zu jobs done (%zu failed, %zu merged), %zu missing; summary: %s\n",
@@ -113,7 +114,7 @@ void addCampaignCommand(CLI::App& app) {
   });
 
   task->callback([args] {
-    const auto campaign = experiments::loadCampaign(args->campaign, args->overrides);
+    const auto campaign = experiments::loadCampaign(resolveDataPath(args->campaign), args->overrides);
     const auto all = experiments::expandJobs(campaign);
     const auto ids = experiments::taskJobIds(io::readFile(args->tasks_file), static_cast<std::size_t>(args->task),
                                              args->tasks_file);
@@ -137,7 +138,7 @@ void addCampaignCommand(CLI::App& app) {
     if (cmd->got_subcommand("collect") || cmd->got_subcommand("run-task")) return;
     if (args->campaign.empty()) throw Error("campaign: give a campaign YAML (or: campaign collect | run-task)");
     if (args->results.empty()) throw Error("campaign: give a results folder with -o");
-    const auto campaign = experiments::loadCampaign(args->campaign, args->overrides);
+    const auto campaign = experiments::loadCampaign(resolveDataPath(args->campaign), args->overrides);
     const auto jobs = experiments::expandJobs(campaign);
     const std::string results = absolutePath(args->results);
 

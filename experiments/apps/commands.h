@@ -25,9 +25,11 @@ void addEvaluateCommand(CLI::App& app);
 void addCampaignCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addExportCommand(CLI::App& app);
+void addImportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addEstimateCommand(CLI::App& app);
 void addHealthCommand(CLI::App& app);
+void addVideoCommand(CLI::App& app);
 
 /// Every subcommand above, in the order `evio --help` lists them (main.cpp;
 /// the command-line fuzzer, tests/fuzz/fuzz_cli.cpp).

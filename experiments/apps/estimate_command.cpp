@@ -1,4 +1,4 @@
-// `evio estimate <sequence> --method eklt-vio|klt-vio|tracks [--config file]
+// `evio estimate <sequence> --method eklt-vio|klt-vio|haste-vio|tracks [--config file]
 //  [--init static|groundtruth] [--set key=value] [--tracks file] [--track-noise px] -o <folder>`: runs an
 // estimator pipeline (estimator/pipeline/pipeline.h) over a sequence folder
 // and writes the estimate folder (trajectory.txt, trajectory_covariance.txt,
@@ -16,26 +16,10 @@
 #include "evio/core/io/config.h"
 #include "evio/core/io/staged_folder.h"
 #include "evio/estimator/pipeline/pipeline.h"
+#include "data_root.h"
 #include "progress_line.h"
 
-#ifndef EVIO_SOURCE_DIR
-#define EVIO_SOURCE_DIR ""
-#endif
-
 namespace evio::apps {
-
-namespace {
-
-/// A config path as given, else relative to the source tree (estimator/config/…).
-std::string resolveConfig(const std::string& path) {
-  namespace fs = std::filesystem;
-  if (fs::exists(path) || fs::path(path).is_absolute()) return path;
-  const fs::path in_tree = fs::path(EVIO_SOURCE_DIR) / path;
-  if (!std::string(EVIO_SOURCE_DIR).empty() && fs::exists(in_tree)) return in_tree.string();
-  return path;
-}
-
-}  // namespace
 
 void addEstimateCommand(CLI::App& app) {
   struct Args {
@@ -53,8 +37,8 @@ void addEstimateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("estimate", "Run EKLT-VIO, KLT-VIO or the backend on tracks over a sequence");
   cmd->add_option("sequence", args->folder, "sequence folder (Event-Camera Dataset layout)")->required();
   cmd->add_option("--method", args->method,
-                  "eklt-vio, klt-vio or tracks (default: the `method` key of --config/--set)")
-      ->check(CLI::IsMember({"eklt-vio", "klt-vio", "tracks"}));
+                  "eklt-vio, klt-vio, haste-vio or tracks (default: the `method` key of --config/--set)")
+      ->check(CLI::IsMember({"eklt-vio", "klt-vio", "haste-vio", "tracks"}));
   cmd->add_option("--config", args->config,
                   "options YAML (estimator/config/*.yaml; keys: frontend, sync, backend, init, calibration, tracks, "
                   "output)");
@@ -72,14 +56,14 @@ void addEstimateCommand(CLI::App& app) {
   cmd->callback([args] {
     io::requireNotStaging(args->folder);
     config::Document doc =
-        args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(resolveConfig(args->config));
+        args->config.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(resolveDataPath(args->config));
     for (const auto& o : args->overrides) config::applyOverride(doc, o);
     // --method wins; else the configuration's `method` (campaign methods set
     // it with --set, e.g. an eklt-vio variant on reconstructed frames).
     if (args->method.empty()) {
       const YAML::Node m = doc.root.IsMap() ? doc.root["method"] : YAML::Node();
       if (!m.IsDefined() || !m.IsScalar())
-        throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|tracks or method: in " +
+        throw Error("evio estimate: no method: give --method eklt-vio|klt-vio|haste-vio|tracks or method: in " +
                     (args->config.empty() ? std::string("--set") : args->config));
       args->method = config::scalarAs<std::string>(doc, m, "method");
       try {
@@ -96,13 +80,14 @@ void addEstimateCommand(CLI::App& app) {
     config::fill(doc, "", options);
 
     io::StagedFolder out(args->output);  // published whole at the end, or not at all
-    ProgressLine line("estimate", args->method == "eklt-vio" ? "ev" : "s data", args->quiet);
+    const bool event_method = args->method == "eklt-vio" || args->method == "haste-vio";  // progress in events
+    ProgressLine line("estimate", event_method ? "ev" : "s data", args->quiet);
     const auto result = estimator::runPipeline(args->folder, options, out.path(), [&](const auto& p) {
       char label[96];
       std::snprintf(label, sizeof(label), "estimate %s t=%.2f s%s", args->method.c_str(), nsToSeconds(p.t_ns),
                     p.initialized ? "" : " (not initialised)");
       line.setLabel(label);
-      line.update(p.fraction, args->method == "eklt-vio" ? static_cast<double>(p.events) : nsToSeconds(p.t_ns));
+      line.update(p.fraction, event_method ? static_cast<double>(p.events) : nsToSeconds(p.t_ns));
     });
     line.finish();
     // "ok" with no pose at all (no events, never initialised) is no result.

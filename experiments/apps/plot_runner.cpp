@@ -8,11 +8,18 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "data_root.h"
+
 namespace evio::apps {
 
 std::string runPlotScript(const std::string& script, const std::vector<std::string>& args) {
   const char* env_dir = std::getenv("EVIO_PLOTS_DIR");
-  const std::filesystem::path dir = env_dir ? env_dir : EVIO_PLOTS_DIR;
+  std::filesystem::path dir;
+  try {
+    dir = env_dir ? std::filesystem::path(env_dir) : dataRoot() / "experiments" / "plots";
+  } catch (const std::exception& e) {
+    return std::string("plot skipped: ") + e.what();
+  }
   const std::string path = (dir / script).string();
   const char* python = "/usr/bin/python3";
   if (!std::filesystem::exists(path)) return "plot script not found: " + path;

@@ -2,8 +2,8 @@
 /// @file plot_runner.h
 /// Runs one of the matplotlib scripts in experiments/plots with Debian's
 /// /usr/bin/python3 (which has python3-matplotlib; the python3 first on PATH
-/// may not). The scripts folder is EVIO_PLOTS_DIR if set, else the source
-/// tree's experiments/plots (compiled in).
+/// may not). The scripts folder is $EVIO_PLOTS_DIR if set, else
+/// experiments/plots of the data folder (data_root.h).
 
 #include <string>
 #include <vector>

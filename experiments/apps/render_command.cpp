@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "data_root.h"
 #include "evio/core/error.h"
 #include "evio/core/io/staged_folder.h"
 #include "evio/simulator/render_job.h"
@@ -53,6 +54,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing on success");
   cmd->callback([args] {
     auto& job = args->job;
+    job.scene_file = resolveDataPath(job.scene_file);
     if (!args->pose.empty() && !args->look_at.empty()) throw Error("--pose and --look-at are exclusive");
     if (!args->pose.empty()) {
       const auto v = numbers(args->pose, 7, "--pose");

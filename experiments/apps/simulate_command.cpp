@@ -8,11 +8,8 @@
 #include "commands.h"
 #include "evio/core/io/staged_folder.h"
 #include "evio/simulator/sequence_simulator.h"
+#include "data_root.h"
 #include "progress_line.h"
-
-#ifndef EVIO_SOURCE_DIR
-#define EVIO_SOURCE_DIR ""
-#endif
 
 namespace evio::apps {
 
@@ -37,7 +34,7 @@ void addSimulateCommand(CLI::App& app) {
   cmd->callback([args] {
     std::vector<std::string> overrides = args->overrides;
     if (args->threads >= 0) overrides.push_back("threads=" + std::to_string(args->threads));
-    const simulator::Scenario scenario = simulator::loadScenario(args->scenario, overrides, EVIO_SOURCE_DIR);
+    const simulator::Scenario scenario = simulator::loadScenario(resolveDataPath(args->scenario), overrides, dataRoot().string());
     io::StagedFolder out(args->folder);  // published whole at the end, or not at all
     ProgressLine line("simulate", "ev", args->quiet);
     const auto stats = simulator::simulateSequence(

@@ -1,4 +1,4 @@
-// `evio track <sequence> --frontend eklt|klt [--image-source frames|reconstructed]
+// `evio track <sequence> --frontend eklt|klt|haste [--image-source frames|reconstructed]
 //  [--config file] [--set key=value] -o tracks.txt`: runs a feature-tracking
 // frontend over a sequence folder and writes its tracks (id t x y), with the
 // resolved configuration beside them (<output>.yaml).
@@ -27,10 +27,10 @@ void addTrackCommand(CLI::App& app) {
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("track", "Track features through a sequence (EKLT or KLT frontend)");
+  CLI::App* cmd = app.add_subcommand("track", "Track features through a sequence (EKLT, KLT or HASTE frontend)");
   cmd->add_option("sequence", args->folder, "sequence folder")->required();
-  cmd->add_option("--frontend", args->frontend, "eklt or klt (overrides the config's tracker)")
-      ->check(CLI::IsMember({"eklt", "klt"}));
+  cmd->add_option("--frontend", args->frontend, "eklt, klt or haste (overrides the config's tracker)")
+      ->check(CLI::IsMember({"eklt", "klt", "haste"}));
   cmd->add_option("--image-source", args->image_source, "frames or reconstructed (from events)")
       ->check(CLI::IsMember({"frames", "reconstructed"}));
   cmd->add_option("--config", args->config, "frontend options YAML (estimator FrontendOptions at the root)");

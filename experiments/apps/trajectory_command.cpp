@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "data_root.h"
 #include "evio/core/io/staged_folder.h"
 #include "evio/simulator/trajectory_export.h"
 #include "plot_runner.h"
@@ -30,7 +31,7 @@ void addTrajectoryCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing on success");
   cmd->callback([args] {
     io::StagedFolder out(args->folder);  // published whole, or not at all
-    const auto summary = exportTrajectoryPreset(args->preset, out.path(), args->overrides);
+    const auto summary = exportTrajectoryPreset(resolveDataPath(args->preset), out.path(), args->overrides);
     out.publish();
     if (!args->quiet)
       std::printf("wrote %lld poses and %lld IMU samples to %s\n", static_cast<long long>(summary.groundtruth_poses),

@@ -2,13 +2,14 @@
 # Feature-tracking table of issue 6: simulates 10 s of poster_6dof,
 # shapes_6dof and mars_yard_circle (plus mars_yard_circle with the frame
 # camera over- and under-exposed), runs EKLT on frames, EKLT on reconstructed
-# images and KLT (`evio track`), scores every track against the truth from
+# images, KLT and HASTE seeded on frames and on reconstructed images (`evio track`), scores every track against the truth from
 # the depth maps and poses (`evio evaluate-tracks`, depth mode) and prints a
 # markdown table; a second table scores the same tracks with a 1 px error
 # bound (how long they stay sub-pixel), a third gives the frames' motion blur.
 #
 #   experiments/scripts/tracking_table.sh [--evio build/release/bin/evio] [--out out/tracking]
 #                                         [--depth-time-tolerance 0.03] [--only NAME]
+#                                         [--methods "eklt_frames eklt_reconstructed klt haste_frames haste_reconstructed"]
 #
 # Sequences and results are kept under --out; a step whose output exists is
 # not run again (delete the folder to redo it). Runs one process at a time.
@@ -37,12 +38,14 @@ EVIO=build/release/bin/evio
 OUT=out/tracking
 TOL=0.03
 ONLY=""
+METHODS="eklt_frames eklt_reconstructed klt haste_frames haste_reconstructed"
 while [ $# -gt 0 ]; do
   case "$1" in
     --evio) EVIO="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --depth-time-tolerance) TOL="$2"; shift 2 ;;
     --only) ONLY="$2"; shift 2 ;;
+    --methods) METHODS="$2"; shift 2 ;;
     *) echo "unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -63,7 +66,6 @@ declare -A SIM=(
 )
 SEQS="poster_6dof shapes_6dof mars_yard_circle mars_yard_circle_overexposed mars_yard_circle_underexposed
       poster_6dof_fast poster_6dof_fast_long shapes_6dof_fast shapes_6dof_fast_long"
-METHODS="eklt_frames eklt_reconstructed klt"
 for s in $SEQS; do
   [ -n "$ONLY" ] && [ "$ONLY" != "$s" ] && continue
   seq="$OUT/$s"
@@ -78,6 +80,8 @@ for s in $SEQS; do
       eklt_frames) args="--frontend eklt --image-source frames" ;;
       eklt_reconstructed) args="--frontend eklt --image-source reconstructed" ;;
       klt) args="--frontend klt --image-source frames" ;;
+      haste_frames) args="--frontend haste --image-source frames" ;;
+      haste_reconstructed) args="--frontend haste --image-source reconstructed" ;;
     esac
     if [ ! -f "$tracks" ]; then
       echo "tracking $s with $m" >&2
@@ -95,7 +99,8 @@ done
 /usr/bin/python3 - "$OUT" "$SEQS" "$METHODS" <<'PY'
 import json, os, sys
 out, seqs, methods = sys.argv[1], sys.argv[2].split(), sys.argv[3].split()
-names = {"eklt_frames": "EKLT (frames)", "eklt_reconstructed": "EKLT (reconstructed)", "klt": "KLT"}
+names = {"eklt_frames": "EKLT (frames)", "eklt_reconstructed": "EKLT (reconstructed)", "klt": "KLT",
+         "haste_frames": "HASTE (frames)", "haste_reconstructed": "HASTE (reconstructed)"}
 def at_age(m, age):
     for b in m["error_vs_age"]:
         if abs(b["age_s"] - age) < 1e-9:

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "evio/core/error.h"
@@ -78,6 +79,26 @@ void emitFlow(YAML::Emitter& out, const std::vector<double>& v) {
   out << YAML::EndSeq;
 }
 
+/// A 3×3 matrix as rows of flow sequences (OpenVINS' Tw, Ta, Tg, R_IMUto*).
+void emitMatrixRows3(YAML::Emitter& out, const Mat3& M) {
+  out << YAML::BeginSeq;
+  for (int r = 0; r < 3; ++r) {
+    out << YAML::Flow << YAML::BeginSeq;
+    for (int c = 0; c < 3; ++c) out << num(M(r, c));
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndSeq;
+}
+
+/// Writes a YAML file as the EuRoC layout and OpenCV's cv::FileStorage (used
+/// by OpenVINS, VINS and most EuRoC readers) want it: "%YAML:1.0" first.
+void writeYaml(const fs::path& path, const YAML::Emitter& e) {
+  io::writeFileAtomic(path.string(), std::string("%YAML:1.0\n---\n") + e.c_str() + "\n");
+}
+
+/// Earth's standard gravity, the value every EuRoC peer assumes unless told.
+constexpr double kPeerDefaultGravity = 9.81;
+
 /// EuRoC's 4×4 matrix block {cols, rows, data}.
 void emitEurocMatrix(YAML::Emitter& out, const Mat4& T) {
   out << YAML::BeginMap << YAML::Key << "cols" << YAML::Value << 4 << YAML::Key << "rows" << YAML::Value << 4;
@@ -93,6 +114,13 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
                                const EurocExportOptions& options) {
   EurocExportSummary summary;
   const fs::path seq(sequence);
+  // A EuRoC sequence is a visual-inertial one: name everything that is missing at once.
+  std::string missing;
+  for (const char* needed : {"sensors.yaml", "images.txt", "imu.txt"})
+    if (!fs::is_regular_file(seq / needed)) missing += std::string(missing.empty() ? "" : ", ") + needed;
+  if (!missing.empty())
+    throw Error(sequence + ": the EuRoC export needs the camera and IMU calibration (sensors.yaml), frames "
+                           "(images.txt) and IMU (imu.txt); missing: " + missing);
   const SensorRig rig = io::readSensorsYaml((seq / "sensors.yaml").string());
   const CameraSensor* cam = options.camera.empty() ? rig.firstCamera(CameraRole::kFrame) : rig.findCamera(options.camera);
   if (!cam && options.camera.empty()) cam = &rig.cameras.front();
@@ -228,7 +256,7 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
     e << YAML::Key << "distortion_coefficients" << YAML::Value;
     emitFlow(e, coeffs);
     e << YAML::EndMap;
-    io::writeFileAtomic((mav / "cam0" / "sensor.yaml").string(), std::string(e.c_str()) + "\n");
+    writeYaml(mav / "cam0" / "sensor.yaml", e);
   }
   {  // mav0/imu0/sensor.yaml
     YAML::Emitter e;
@@ -243,7 +271,7 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
     e << YAML::Key << "accelerometer_noise_density" << YAML::Value << num(rig.imu.accelerometer_noise_density);
     e << YAML::Key << "accelerometer_random_walk" << YAML::Value << num(rig.imu.accelerometer_random_walk);
     e << YAML::EndMap;
-    io::writeFileAtomic((mav / "imu0" / "sensor.yaml").string(), std::string(e.c_str()) + "\n");
+    writeYaml(mav / "imu0" / "sensor.yaml", e);
   }
   {  // camchain.yaml (Kalibr imu-cam chain)
     YAML::Emitter e;
@@ -262,7 +290,7 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
     e << YAML::Key << "rostopic" << YAML::Value << "/cam0/image_raw";
     e << YAML::Key << "timeshift_cam_imu" << YAML::Value << num(timeshift_s);
     e << YAML::EndMap << YAML::EndMap;
-    io::writeFileAtomic((out / "camchain.yaml").string(), std::string(e.c_str()) + "\n");
+    writeYaml(out / "camchain.yaml", e);
   }
   {  // imu.yaml (Kalibr IMU)
     YAML::Emitter e;
@@ -274,11 +302,56 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
     e << YAML::Key << "gyroscope_noise_density" << YAML::Value << num(rig.imu.gyroscope_noise_density);
     e << YAML::Key << "gyroscope_random_walk" << YAML::Value << num(rig.imu.gyroscope_random_walk);
     e << YAML::Key << "model" << YAML::Value << "calibrated";
+    // OpenVINS reads the IMU intrinsics even for a calibrated model: the
+    // simulator's IMU has unit scale, aligned axes and no g-sensitivity.
+    e << YAML::Key << "Tw" << YAML::Value;
+    emitMatrixRows3(e, Mat3::Identity());
+    e << YAML::Key << "R_IMUtoGYRO" << YAML::Value;
+    emitMatrixRows3(e, Mat3::Identity());
+    e << YAML::Key << "Ta" << YAML::Value;
+    emitMatrixRows3(e, Mat3::Identity());
+    e << YAML::Key << "R_IMUtoACC" << YAML::Value;
+    emitMatrixRows3(e, Mat3::Identity());
+    e << YAML::Key << "Tg" << YAML::Value;
+    emitMatrixRows3(e, Mat3::Zero());
     e << YAML::Key << "rostopic" << YAML::Value << "/imu0";
     e << YAML::Key << "time_offset" << YAML::Value << num(0.0);
     e << YAML::Key << "update_rate" << YAML::Value << num(rig.imu.update_rate);
     e << YAML::EndMap << YAML::EndMap;
-    io::writeFileAtomic((out / "imu.yaml").string(), std::string(e.c_str()) + "\n");
+    writeYaml(out / "imu.yaml", e);
+  }
+  {  // mav0/body.yaml and the ground truth's sensor.yaml, as in the EuRoC layout
+    YAML::Emitter body;
+    body << YAML::BeginMap << YAML::Key << "comment" << YAML::Value
+         << "The body frame B is the IMU frame; every T_BS is the sensor's pose in it." << YAML::EndMap;
+    writeYaml(mav / "body.yaml", body);
+    YAML::Emitter gt;
+    gt << YAML::BeginMap << YAML::Key << "sensor_type" << YAML::Value << "visual-inertial";
+    gt << YAML::Key << "comment" << YAML::Value
+       << (summary.groundtruth_from_imu_state
+               ? "Exact ground truth of the evio simulator: body pose, velocity and IMU biases."
+               : "Body poses from groundtruth.txt and T_B_C; velocity by finite differences; biases 0.");
+    gt << YAML::Key << "T_BS" << YAML::Value;
+    emitEurocMatrix(gt, Mat4::Identity());
+    gt << YAML::EndMap;
+    writeYaml(mav / "state_groundtruth_estimate0" / "sensor.yaml", gt);
+  }
+  // Gravity: EuRoC has no field for it and every peer assumes Earth's unless
+  // told, so a Mars sequence would run with the wrong gravity silently.
+  // estimator_config.yaml is where OpenVINS reads it (gravity_mag), beside
+  // the paths of the two Kalibr files.
+  if (std::abs(rig.gravity_m_s2 - kPeerDefaultGravity) > 0.01)
+    summary.warnings.push_back("gravity is " + num(rig.gravity_m_s2) +
+                               " m/s^2, not Earth's: EuRoC has no field for it; estimator_config.yaml gives it to "
+                               "OpenVINS (gravity_mag); set it by hand in any other peer, which assumes 9.81");
+  {
+    YAML::Emitter e;
+    e << YAML::BeginMap;
+    e << YAML::Key << "gravity_mag" << YAML::Value << num(rig.gravity_m_s2);
+    e << YAML::Key << "relative_config_imu" << YAML::Value << "imu.yaml";
+    e << YAML::Key << "relative_config_imucam" << YAML::Value << "camchain.yaml";
+    e << YAML::EndMap;
+    writeYaml(out / "estimator_config.yaml", e);
   }
   {  // evio_export.yaml
     YAML::Emitter e;
@@ -294,7 +367,7 @@ EurocExportSummary exportEuroc(const std::string& sequence, const std::string& f
     e << YAML::Key << "warnings" << YAML::Value << YAML::BeginSeq;
     for (const auto& w : summary.warnings) e << w;
     e << YAML::EndSeq << YAML::EndMap;
-    io::writeFileAtomic((out / "evio_export.yaml").string(), std::string(e.c_str()) + "\n");
+    writeYaml(out / "evio_export.yaml", e);
   }
   return summary;
 }

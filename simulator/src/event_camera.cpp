@@ -89,27 +89,47 @@ inline float phiOf(float x, float e) {
 }
 
 /// Constants of the per-pixel arithmetic, shared by the block and the
-/// per-pixel paths so that both give bit-identical results.
+/// per-pixel paths so that both give bit-identical results. The
+/// photoreceptor cut-off is f_c(v) = fmin + fspan · v/(v + iref) + fslope · v:
+/// the legacy hyperbola (fslope = 0) or κ·k·(ε + v) (fspan = 0).
 struct PixelMath {
-  float eps, fmin, fspan, iref, rshot, bshot;
+  float eps, fmin, fspan, fslope, iref, rshot, bshot, xsf;
 
   explicit PixelMath(const EventCamera::Options& o)
-      : eps(static_cast<float>(o.log_eps_w_m2_sr)),
-        fmin(static_cast<float>(o.cutoff_min_hz)),
-        fspan(static_cast<float>(o.cutoff_max_hz - o.cutoff_min_hz)),
-        iref(static_cast<float>(o.reference_radiance_w_m2_sr)),
+      : eps(static_cast<float>(o.logEpsilon())),
         rshot(static_cast<float>(o.shot_noise_rate_hz)),
-        bshot(1.0f - static_cast<float>(o.shot_noise_bright_factor)) {}
+        bshot(1.0f - static_cast<float>(o.shot_noise_bright_factor)),
+        xsf(kTwoPi * static_cast<float>(o.source_follower_hz)) {
+    if (o.photocurrentModel()) {
+      const double k = o.photocurrentPerRadiancePa();  // pA per W/(m² sr)
+      fmin = static_cast<float>(o.photoreceptor_hz_per_pa * o.dark_current_fa * 1e-3);
+      fspan = 0.0f;
+      fslope = static_cast<float>(o.photoreceptor_hz_per_pa * k);
+      iref = static_cast<float>(o.shot_noise_reference_pa / k);
+    } else {
+      fmin = static_cast<float>(o.cutoff_min_hz);
+      fspan = static_cast<float>(o.cutoff_max_hz - o.cutoff_min_hz);
+      fslope = 0.0f;
+      iref = static_cast<float>(o.reference_radiance_w_m2_sr);
+    }
+  }
 
   /// max(I, 0), NaN → 0.
   static float clampRadiance(float v) { return v > 0.0f ? v : 0.0f; }
   float logOf(float v) const { return fastLog(eps + v); }
-  /// L_f at the new sample (exact first-order step, piecewise-linear input).
-  float filtered(float v, float dt_s, float lin, float lin0, float lf0) const {
-    const float x = kTwoPi * (fmin + fspan * (v / (v + iref))) * dt_s;
+  /// Exact first-order step over dt for an input linear from in0 to in:
+  /// the output at the new sample, from out0, with x = 2π f_c dt.
+  static float lowPass(float x, float in, float in0, float out0) {
     const float e = fastExpNonPositive(-x);
-    return lin + (lf0 - lin0) * e - (lin - lin0) * phiOf(x, e);
+    return in + (out0 - in0) * e - (in - in0) * phiOf(x, e);
   }
+  /// L_p at the new sample (photoreceptor).
+  float photoreceptor(float v, float dt_s, float lin, float lin0, float lp0) const {
+    const float fc = fmin + fspan * (v / (v + iref)) + fslope * v;
+    return lowPass(kTwoPi * fc * dt_s, lin, lin0, lp0);
+  }
+  /// L_f at the new sample (source follower of fixed cut-off).
+  float follower(float dt_s, float lp, float lp0, float lf0) const { return lowPass(xsf * dt_s, lp, lp0, lf0); }
   float shotRate(float v) const { return rshot * (1.0f - bshot * (v / (v + iref))); }
 };
 
@@ -132,12 +152,25 @@ void EventCamera::Options::validate() const {
   requireNonNegative("threshold_jitter_sigma", threshold_jitter_sigma);
   requirePositive("threshold_min", threshold_min);
   requireNonNegative("refractory_period_s", refractory_period_s);
+  requireInRange("refractory_mismatch_sigma", refractory_mismatch_sigma, 0.0, 1.0);
   requirePositive("log_eps_w_m2_sr", log_eps_w_m2_sr);
   requireInRange("cutoff_max_hz", cutoff_max_hz, 0.0, 1e6);
   requirePositive("cutoff_min_hz", cutoff_min_hz);
   requireField(cutoff_max_hz == 0.0 || cutoff_min_hz <= cutoff_max_hz, "cutoff_min_hz",
                "must be <= cutoff_max_hz");
   requirePositive("reference_radiance_w_m2_sr", reference_radiance_w_m2_sr);
+  requireField(bandwidth_model == "radiance" || bandwidth_model == "photocurrent", "bandwidth_model",
+               "must be radiance or photocurrent");
+  requireInRange("f_number", f_number, 0.5, 64.0);
+  requireInRange("lens_transmission", lens_transmission, 1e-3, 1.0);
+  requireInRange("photodiode_area_um2", photodiode_area_um2, 1e-3, 1e4);
+  requireInRange("quantum_efficiency", quantum_efficiency, 1e-3, 1.0);
+  requireInRange("wavelength_nm", wavelength_nm, 200.0, 2000.0);
+  requireInRange("dark_current_fa", dark_current_fa, 1e-3, 1e6);
+  requireInRange("photoreceptor_hz_per_pa", photoreceptor_hz_per_pa, 1e-3, 1e7);
+  requireInRange("shot_noise_reference_pa", shot_noise_reference_pa, 1e-6, 1e6);
+  requireInRange("source_follower_hz", source_follower_hz, 0.0, 1e7);
+  requireInRange("ba_filter_window_s", ba_filter_window_s, 0.0, 10.0);
   // Noise rates are per pixel; real sensors stay below ~1 Hz. The bounds keep
   // a typo from turning a short sequence into an endless event stream.
   requireInRange("leak_rate_hz", leak_rate_hz, 0.0, 1e4);
@@ -146,6 +179,26 @@ void EventCamera::Options::validate() const {
   requireInRange("hot_pixel_fraction", hot_pixel_fraction, 0.0, 1.0);
   requireInRange("hot_pixel_rate_hz", hot_pixel_rate_hz, 0.0, 1e4);
   requireInRange("threads", threads, 0, 1024);
+}
+
+double EventCamera::Options::photocurrentPerRadiancePa() const {
+  constexpr double kPlanck = 6.62607015e-34;      // J s
+  constexpr double kLight = 2.99792458e8;         // m/s
+  constexpr double kElectron = 1.602176634e-19;   // C
+  const double photons_per_joule = wavelength_nm * 1e-9 / (kPlanck * kLight);
+  const double etendue = std::numbers::pi * lens_transmission / (4.0 * f_number * f_number);  // (W/m²)/(W/(m² sr))
+  return kElectron * quantum_efficiency * photodiode_area_um2 * 1e-12 * photons_per_joule * etendue * 1e12;
+}
+
+double EventCamera::Options::logEpsilon() const {
+  return photocurrentModel() ? dark_current_fa * 1e-3 / photocurrentPerRadiancePa() : log_eps_w_m2_sr;
+}
+
+double EventCamera::Options::photoreceptorCutoffHz(double radiance) const {
+  const double v = std::max(radiance, 0.0);
+  if (photocurrentModel()) return photoreceptor_hz_per_pa * (photocurrentPerRadiancePa() * v + dark_current_fa * 1e-3);
+  if (cutoff_max_hz == 0.0) return 0.0;
+  return cutoff_min_hz + (cutoff_max_hz - cutoff_min_hz) * v / (v + reference_radiance_w_m2_sr);
 }
 
 EventCamera::EventCamera(int width, int height, const Options& options, std::uint64_t seed)
@@ -161,15 +214,26 @@ EventCamera::EventCamera(int width, int height, const Options& options, std::uin
   key_mismatch_ = counterKey(seed, "event_threshold_mismatch");
   key_jitter_ = counterKey(seed, "event_jitter");
   key_shot_ = counterKey(seed, "event_shot_noise");
-  bandwidth_ = options_.cutoff_max_hz > 0.0;
+  bandwidth_ = options_.photocurrentModel() || options_.cutoff_max_hz > 0.0;
+  follower_ = options_.source_follower_hz > 0.0;
+  if (options_.ba_filter_window_s > 0.0)
+    ba_filter_ = std::make_unique<BackgroundActivityFilter>(width, height, secondsToNs(options_.ba_filter_window_s));
   shot_ = options_.shot_noise_rate_hz > 0.0;
   jitter_ = options_.threshold_jitter_sigma > 0.0;
   refractory_ns_ = secondsToNs(options_.refractory_period_s);
+  if (options_.refractory_mismatch_sigma > 0.0) {
+    const std::uint64_t key = counterKey(seed, "event_refractory_mismatch");
+    refractory_px_.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+    for (std::size_t i = 0; i < refractory_px_.size(); ++i)
+      refractory_px_[i] = secondsToNs(options_.refractory_period_s *
+                                      std::exp(options_.refractory_mismatch_sigma * counterNormal(key, i, 0)));
+  }
 
   t_prev_.assign(n_, 0);
   t_last_event_.assign(n_, std::numeric_limits<TimeNs>::min() / 2);
   lin_prev_.assign(n_, 0.0f);
   lf_prev_.assign(n_, 0.0f);
+  if (follower_) lpr_prev_.assign(n_, 0.0f);
   ref_.assign(n_, 0.0f);
   th_pos_.resize(n_);
   th_neg_.resize(n_);
@@ -231,6 +295,7 @@ void EventCamera::initialize(TimeNs t_ns, const float* radiance) {
     const float l = pm.logOf(PixelMath::clampRadiance(radiance[i]));
     lin_prev_[i] = l;
     lf_prev_[i] = l;
+    if (follower_) lpr_prev_[i] = l;
     ref_[i] = l;
   }
   uniform_ = true;
@@ -295,7 +360,7 @@ void EventCamera::update(TimeNs t_ns, const float* radiance, EventArray* events,
 void EventCamera::processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, const float* radiance,
                                std::vector<Pending>* out) {
   const PixelMath pm(options_);
-  float lin[kChunk], lf[kChunk], dt[kChunk], hazard[kChunk], rate[kChunk], v[kChunk];
+  float lin[kChunk], lp[kChunk], lf[kChunk], dt[kChunk], hazard[kChunk], rate[kChunk], v[kChunk];
   std::uint8_t cross[kChunk + 8] = {}, shot[kChunk + 8] = {};  // + 8: whole 8-byte words at the end
   const bool uniform = uniform_;
   const float dt_uniform = static_cast<float>(t_ns - uniform_t_) * 1e-9f;
@@ -311,12 +376,18 @@ void EventCamera::processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, 
     } else {
       for (std::size_t j = 0; j < m; ++j) dt[j] = static_cast<float>(t_ns - t_prev_[c + j]) * 1e-9f;
     }
+    const float* lp0 = (follower_ ? lpr_prev_.data() : lf_prev_.data()) + c;
     if (bandwidth_) {
       const float* lin0 = lin_prev_.data() + c;
-      const float* lf0 = lf_prev_.data() + c;
-      for (std::size_t j = 0; j < m; ++j) lf[j] = pm.filtered(v[j], dt[j], lin[j], lin0[j], lf0[j]);
+      for (std::size_t j = 0; j < m; ++j) lp[j] = pm.photoreceptor(v[j], dt[j], lin[j], lin0[j], lp0[j]);
     } else {
-      for (std::size_t j = 0; j < m; ++j) lf[j] = lin[j];
+      for (std::size_t j = 0; j < m; ++j) lp[j] = lin[j];
+    }
+    if (follower_) {
+      const float* lf_old = lf_prev_.data() + c;
+      for (std::size_t j = 0; j < m; ++j) lf[j] = pm.follower(dt[j], lp[j], lp0[j], lf_old[j]);
+    } else {
+      for (std::size_t j = 0; j < m; ++j) lf[j] = lp[j];
     }
     if (shot_) {
       for (std::size_t j = 0; j < m; ++j) {
@@ -353,6 +424,7 @@ void EventCamera::processBlock(std::size_t begin, std::size_t end, TimeNs t_ns, 
       }
     }
     std::copy(lf, lf + m, lf_prev_.data() + c);
+    if (follower_) std::copy(lp, lp + m, lpr_prev_.data() + c);
     if (bandwidth_) std::copy(lin, lin + m, lin_prev_.data() + c);
   }
 }
@@ -363,6 +435,7 @@ void EventCamera::crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float
   const double dl = static_cast<double>(l1) - static_cast<double>(l0);
   const double span = static_cast<double>(t1 - t0);
   const float c_min = static_cast<float>(options_.threshold_min);
+  const TimeNs refractory = refractoryNs(i);
   float base_pos = 0.0f, base_neg = 0.0f;
   if (jitter_) {
     base_pos = thresholdPos(i);
@@ -372,7 +445,7 @@ void EventCamera::crossings(std::size_t i, TimeNs t0, TimeNs t1, float l0, float
     double frac = dl != 0.0 ? (static_cast<double>(r) - static_cast<double>(l0)) / dl : 1.0;
     frac = std::clamp(frac, 0.0, 1.0);
     const TimeNs t = std::clamp<TimeNs>(t0 + static_cast<TimeNs>(frac * span + 0.5), t0 + 1, t1);
-    if (t - t_last_event_[i] >= refractory_ns_) {
+    if (t - t_last_event_[i] >= refractory) {
       out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
                              EventLabel::kSignal});
       t_last_event_[i] = t;
@@ -406,12 +479,20 @@ void EventCamera::shotNoise(std::size_t i, TimeNs t0, TimeNs t1, float hazard, f
   double acc = static_cast<double>(shot_budget_[i]);
   const double h = static_cast<double>(hazard);
   std::uint32_t k = shot_count_[i];
+  const TimeNs refractory = refractoryNs(i);
   while (acc <= h) {
     const TimeNs t =
         std::clamp<TimeNs>(t0 + static_cast<TimeNs>(acc / static_cast<double>(rate_hz) * 1e9 + 0.5), t0 + 1, t1);
     const bool positive = counterUniform(key_shot_, i, 2ull * k + 1) < 0.5;
-    out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
-                           EventLabel::kShot});
+    // A shot event is a real reset of the pixel: none within the refractory
+    // period of the pixel's last emitted event, on either side (the signal
+    // crossings of this interval are placed first).
+    const TimeNs gap = t - t_last_event_[i];
+    if (gap >= refractory || -gap >= refractory) {
+      out->push_back(Pending{t, static_cast<std::uint32_t>(i), static_cast<std::uint8_t>(positive ? 1 : 0),
+                             EventLabel::kShot});
+      t_last_event_[i] = std::max(t_last_event_[i], t);
+    }
     ++k;
     acc += counterExponential(key_shot_, i, 2ull * k);
   }
@@ -451,10 +532,16 @@ inline void EventCamera::stepPixel(std::size_t i, TimeNs t_ns, float radiance) {
   const float v = PixelMath::clampRadiance(radiance);
   const float lin = pm.logOf(v);
   const float dt = static_cast<float>(t_ns - t0) * 1e-9f;
-  float lf = lin;
+  float lp = lin;
+  const float lp0 = follower_ ? lpr_prev_[i] : lf_prev_[i];
   if (bandwidth_) {
-    lf = pm.filtered(v, dt, lin, lin_prev_[i], lf_prev_[i]);
+    lp = pm.photoreceptor(v, dt, lin, lin_prev_[i], lp0);
     lin_prev_[i] = lin;
+  }
+  float lf = lp;
+  if (follower_) {
+    lf = pm.follower(dt, lp, lp0, lf_prev_[i]);
+    lpr_prev_[i] = lp;
   }
   if (lf - ref_[i] >= th_pos_[i] || ref_[i] - lf >= th_neg_[i]) crossings(i, t0, t_ns, lf_prev_[i], lf, &pending_);
   if (shot_) {
@@ -504,7 +591,18 @@ void EventCamera::appendSorted(TimeNs watermark, EventArray* events, std::vector
   const auto ready_end = std::partition(pending_.begin(), pending_.end(),
                                         [watermark](const Pending& p) { return p.t_ns <= watermark; });
   sortPending(pending_.begin(), ready_end, n_, &sort_keys_, &sort_scratch_);
-  const auto count = static_cast<std::size_t>(ready_end - pending_.begin());
+  const auto ready = static_cast<std::size_t>(ready_end - pending_.begin());
+  const auto w = static_cast<std::uint32_t>(width_);
+  std::size_t count = ready;
+  if (ba_filter_) {  // in output order, as the camera's logic sees them; kept events move to the front
+    count = 0;
+    for (std::size_t j = 0; j < ready; ++j) {
+      const Pending& e = pending_[j];
+      if (ba_filter_->pass(static_cast<std::uint16_t>(e.pixel % w), static_cast<std::uint16_t>(e.pixel / w), e.t_ns))
+        pending_[count++] = e;
+    }
+    ba_dropped_ += ready - count;
+  }
   if (events != nullptr) {
     const std::size_t base = events->size();
     events->resize(base + count);
@@ -512,7 +610,6 @@ void EventCamera::appendSorted(TimeNs watermark, EventArray* events, std::vector
     std::uint16_t* x = events->x().data() + base;
     std::uint16_t* y = events->y().data() + base;
     std::uint8_t* p = events->p().data() + base;
-    const auto w = static_cast<std::uint32_t>(width_);
     for (std::size_t j = 0; j < count; ++j) {
       const Pending& e = pending_[j];
       t[j] = e.t_ns;
@@ -526,7 +623,7 @@ void EventCamera::appendSorted(TimeNs watermark, EventArray* events, std::vector
     labels->resize(base + count);
     for (std::size_t j = 0; j < count; ++j) (*labels)[base + j] = pending_[j].label;
   }
-  pending_.erase(pending_.begin(), ready_end);
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(ready));
 }
 
 }  // namespace evio::simulator

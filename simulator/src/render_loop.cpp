@@ -35,7 +35,7 @@ CameraVelocity cameraVelocity(const TrajectoryState& s, const Pose& T_B_C) {
 class StepPredictor {
  public:
   StepPredictor(const RenderScheduleOptions& o, const EventCamera::Options& ec)
-      : sampler_(samplerOptions(o), std::min(ec.threshold_pos, ec.threshold_neg), ec.log_eps_w_m2_sr),
+      : sampler_(samplerOptions(o), std::min(ec.threshold_pos, ec.threshold_neg), ec.logEpsilon()),
         quantile_(o.fastest_pixel_quantile) {}
 
   TimeNs interval(const cv::Mat& radiance, const cv::Mat& flow) {
@@ -71,8 +71,9 @@ class StepPredictor {
 };
 
 /// t = target^γ · full_well / (K · mean radiance) within the exposure limits:
-/// the exposure whose noise-free mean DN / 255 is the target (linear until
-/// saturation), NaN and negative radiance counting as 0.
+/// the exposure that fills the mean pixel's well to the fraction target^γ
+/// (legacy sensor: mean DN / 255 = target), NaN and negative radiance
+/// counting as 0. Called with auto-exposure on only.
 double meteredExposure(const cv::Mat& radiance, const FrameCamera::Options& o, const FrameCamera& camera) {
   double sum = 0.0;
   for (int y = 0; y < radiance.rows; ++y) {
@@ -80,8 +81,8 @@ double meteredExposure(const cv::Mat& radiance, const FrameCamera::Options& o, c
     for (int x = 0; x < radiance.cols; ++x) sum += r[x] > 0.0f ? static_cast<double>(r[x]) : 0.0;
   }
   const double mean = sum / (static_cast<double>(radiance.rows) * static_cast<double>(radiance.cols));
-  const double lo = o.auto_exposure ? o.auto_exposure_min_s : 1e-6;
-  const double hi = o.auto_exposure ? o.auto_exposure_max_s : o.exposure_s;
+  const double lo = o.auto_exposure_min_s;
+  const double hi = o.auto_exposure_max_s;
   if (!(mean > 0.0)) return hi;
   const double t = std::pow(o.auto_exposure_target, o.gamma) * o.full_well_e /
                    (camera.electronsPerRadianceSecond() * mean);
@@ -92,8 +93,8 @@ double meteredExposure(const cv::Mat& radiance, const FrameCamera::Options& o, c
 struct FrameInProgress {
   std::size_t index = 0;
   TimeNs start_ns = 0;
-  TimeNs stamp_ns = 0;             ///< mid-exposure, as FrameCamera::capture stamps it
-  std::vector<TimeNs> sample_ns;   ///< N times, both ends of the exposure included
+  TimeNs stamp_ns = 0;             ///< middle of the span, as FrameCamera::capture stamps it
+  std::vector<TimeNs> sample_ns;   ///< N times, both ends of the span included
   std::vector<cv::Mat> images;
   bool depth_done = false;
   TimeNs next() const { return sample_ns[images.size()]; }
@@ -127,8 +128,11 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   if (frames) {
     FrameCamera::Options fco = fo.sensor;
     fco.threads = o.threads;
+    // The exposure never outlasts the frame period minus the readout.
+    fco.auto_exposure_max_s = std::min(fco.auto_exposure_max_s, 1.0 / fo.rate_hz - fco.readout_s);
+    fco.auto_exposure_min_s = std::min(fco.auto_exposure_min_s, fco.auto_exposure_max_s);
     const Camera c = scenario.frameCamera();
-    if (fo.meter_first_exposure) {
+    if (fo.meter_first_exposure && fco.auto_exposure) {
       const Pose T_W_F = trajectory.evaluate(scenario.start_ns).T_W_B * T_B_F;
       const Stopwatch watch;
       const RenderOutput view = (separate ? *frame_renderer : renderer).render(T_W_F);
@@ -147,22 +151,22 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   std::optional<FrameInProgress> frame;
   const auto beginFrame = [&] {
     const TimeNs start = scenario.start_ns + static_cast<TimeNs>(std::llround(static_cast<double>(frame_k) * 1e9 / fo.rate_hz));
-    const double exposure = frame_cam->exposureS();
-    const TimeNs exposure_ns = secondsToNs(exposure);
-    if (start + exposure_ns > scenario.end_ns) {
+    // The frame's span: the first row's exposure start to the last row's end.
+    const double span = frame_cam->frameSpanS(frame_cam->exposureS());
+    if (start + secondsToNs(span) > scenario.end_ns) {
       frames_done = true;
       return;
     }
     FrameInProgress f;
     f.index = frame_k;
     f.start_ns = start;
-    f.stamp_ns = start + secondsToNs(0.5 * exposure);
+    f.stamp_ns = start + secondsToNs(0.5 * span);
     const int n = fo.exposure_samples;
     for (int j = 0; j < n; ++j) {
       // The middle sample of an odd N is exactly the stamp (one render serves both).
       const TimeNs t = n == 1 ? start
                        : 2 * j == n - 1 ? f.stamp_ns
-                                        : start + secondsToNs(exposure * static_cast<double>(j) / (n - 1));
+                                        : start + secondsToNs(span * static_cast<double>(j) / (n - 1));
       if (f.sample_ns.empty() || t > f.sample_ns.back()) f.sample_ns.push_back(t);
     }
     frame = std::move(f);

@@ -138,6 +138,18 @@ Scenario loadScenarioDocument(config::Document doc, const std::string& base_dir,
                               overriddenBelow(doc, "rig.event_camera")};
   config::fill(camera_doc, "", o.rig.event_camera);
 
+  // 1b. The frame camera's sensor preset, under the scenario's keys.
+  const YAML::Node frame_node = rig_node.IsMap() ? rig_node["frame_camera"] : YAML::Node();
+  if (frame_node.IsDefined() && frame_node.IsMap()) {
+    const YAML::Node preset = frame_node["preset"];
+    if (preset.IsDefined() && !preset.IsNull() && !(preset.IsScalar() && preset.Scalar().empty())) {
+      if (!preset.IsScalar()) config::throwAt(doc, preset, "rig.frame_camera.preset", "expected a file path");
+      const std::string path = resolvePath(preset.Scalar(), base_dir, search_root,
+                                           config::where(doc, preset, "rig.frame_camera.preset"));
+      config::fill(config::loadFile(path), "", o.rig.frame_camera.sensor);
+    }
+  }
+
   // 2. Every other field: the sections read on their own are taken out of
   // the (local) document, which keeps its nodes' line numbers (a clone would not).
   const YAML::Node scene_node = doc.root[kScene];
@@ -216,6 +228,7 @@ Scenario loadScenarioString(const std::string& text, const std::string& name, co
 std::string Scenario::resolvedYaml() const {
   ScenarioOptions o = options;
   o.rig.event_camera.preset.clear();  // every field is inline
+  o.rig.frame_camera.preset.clear();
   YAML::Emitter out;
   out << YAML::BeginMap;
   out << YAML::Key << "version" << YAML::Value << evioVersion();

@@ -52,9 +52,11 @@ void FrameCameraRigOptions::validate() const {
   requireField(!name.empty(), "name", "must not be empty");
   sensor.validate();
   const double period_s = 1.0 / rate_hz;
-  requireField(sensor.exposure_s <= period_s, "sensor.exposure_s", "must not exceed the frame period 1 / rate_hz");
-  requireField(!sensor.auto_exposure || sensor.auto_exposure_max_s <= period_s, "sensor.auto_exposure_max_s",
-               "must not exceed the frame period 1 / rate_hz");
+  requireField(sensor.readout_s < period_s, "sensor.readout_s", "must be shorter than the frame period 1 / rate_hz");
+  requireField(sensor.auto_exposure || sensor.exposure_s + sensor.readout_s <= period_s * (1.0 + 1e-9),
+               "sensor.exposure_s", "plus sensor.readout_s must not exceed the frame period 1 / rate_hz");
+  requireField(!sensor.auto_exposure || sensor.auto_exposure_min_s + sensor.readout_s < period_s,
+               "sensor.auto_exposure_min_s", "plus sensor.readout_s must be shorter than the frame period 1 / rate_hz");
   if (!co_located) {
     createCamera("frame_camera", model, width, height, intrinsics, distortion);
     rigidFromMatrix(T_B_F, "T_B_F");
@@ -151,7 +153,13 @@ SensorRig Scenario::sensorRig() const {
                      {"rate_hz", r.frame_camera.rate_hz},
                      {"exposure_samples", static_cast<double>(r.frame_camera.exposure_samples)},
                      {"auto_exposure", r.frame_camera.sensor.auto_exposure ? 1.0 : 0.0},
-                     {"exposure_s", r.frame_camera.sensor.exposure_s}};
+                     {"auto_exposure_davis", r.frame_camera.sensor.auto_exposure_method == "davis" ? 1.0 : 0.0},
+                     {"exposure_s", r.frame_camera.sensor.exposure_s},
+                     {"rolling_shutter", r.frame_camera.sensor.shutter == "rolling" ? 1.0 : 0.0},
+                     {"readout_s", r.frame_camera.sensor.readout_s},
+                     {"full_well_e", r.frame_camera.sensor.full_well_e},
+                     {"dark_offset_dn", r.frame_camera.sensor.dark_offset_dn},
+                     {"saturation_dn", r.frame_camera.sensor.saturation_dn}};
     rig.cameras.push_back(fr);
   }
   rig.imu.accelerometer_noise_density = r.imu.accelerometer_noise_density;

@@ -34,8 +34,8 @@ SequenceItem imuItem(TimeNs t_cam_ns, TimeNs offset_ns = 0) {
 }
 
 TEST(PipelineMethods, EveryMethodParsesBackAndSetsItsFrontend) {
-  EXPECT_EQ(methodNames(), "eklt-vio, klt-vio, tracks");
-  for (const Method m : {Method::kEkltVio, Method::kKltVio, Method::kTracks}) {
+  EXPECT_EQ(methodNames(), "eklt-vio, klt-vio, haste-vio, tracks");
+  for (const Method m : {Method::kEkltVio, Method::kKltVio, Method::kHasteVio, Method::kTracks}) {
     const MethodInfo& info = methodInfo(m);
     ASSERT_EQ(parseMethod(info.name), m);
     const PipelineOptions o = PipelineOptions::forMethod(info.name);
@@ -51,6 +51,9 @@ TEST(PipelineMethods, EveryMethodParsesBackAndSetsItsFrontend) {
   PipelineOptions o = PipelineOptions::forMethod("klt-vio");
   o.frontend.tracker = "eklt";
   EXPECT_THROW(o.validate(), Error);
+  const PipelineOptions haste = PipelineOptions::forMethod("haste-vio");
+  EXPECT_EQ(haste.frontend.tracker, "haste");
+  EXPECT_EQ(haste.sync.trigger, "events");  // synchronised like EKLT-VIO
 }
 
 TEST(PipelineStages, PrefilterPassesEverythingThroughWhenOffAndCountsWhatItDrops) {

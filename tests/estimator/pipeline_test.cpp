@@ -233,10 +233,15 @@ TEST(PipelineBadInput, NoFramesForFrameBasedTrackingSaysWhatToDo) {
                         {"no frames", "frontend.image_source=reconstructed"});
   expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("klt-vio"), dir.file("out")); },
                         {"no frames", "KLT-VIO needs frames"});
+  expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("haste-vio"), dir.file("out")); },
+                        {"no frames", "frontend.image_source=reconstructed"});
   // The documented alternative runs.
   PipelineOptions o = fromGroundTruth("eklt-vio");
   o.frontend.image_source = "reconstructed";
   EXPECT_NO_THROW(runPipeline(seq, o, dir.file("out")));
+  PipelineOptions h = fromGroundTruth("haste-vio");
+  h.frontend.image_source = "reconstructed";
+  EXPECT_NO_THROW(runPipeline(seq, h, dir.file("out_haste")));
 }
 
 TEST(PipelineBadInput, FrameSizeNotTheCalibrationsNamesBoth) {

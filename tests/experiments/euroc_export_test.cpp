@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <opencv2/core/persistence.hpp>
+
 #include <filesystem>
 #include <opencv2/core.hpp>
 
@@ -97,7 +99,7 @@ TEST(EurocExport, WritesTheAslLayoutWithKalibrCalibration) {
   EXPECT_EQ(summary.imu_samples, 20u);
   EXPECT_EQ(summary.groundtruth_poses, s.groundtruth.size());
   EXPECT_FALSE(summary.groundtruth_from_imu_state);
-  ASSERT_EQ(summary.warnings.size(), 1u);  // ground truth from groundtruth.txt (fisheye: no k3 warning)
+  ASSERT_EQ(summary.warnings.size(), 2u);  // ground truth from groundtruth.txt, Mars gravity (fisheye: no k3 warning)
 
   // cam0: ns stamps, files renamed to <t_ns>.png with the same bytes.
   const auto cam_rows = parseCsv(io::readFile(out + "/mav0/cam0/data.csv"));
@@ -174,8 +176,9 @@ TEST(EurocExport, UsesTheTrueImuStateAndWarnsAboutADroppedK3) {
   io::writeImuStateText(seq + "/truth/imu_state.txt", states);
   const auto summary = exportEuroc(seq, dir.file("euroc"), {"dvs"});  // the radtan event camera as cam0
   EXPECT_TRUE(summary.groundtruth_from_imu_state);
-  ASSERT_EQ(summary.warnings.size(), 1u);
+  ASSERT_EQ(summary.warnings.size(), 2u);  // the dropped k3, and Mars gravity no peer assumes
   EXPECT_NE(summary.warnings[0].find("k3"), std::string::npos);
+  EXPECT_NE(summary.warnings[1].find("gravity is 3.721"), std::string::npos);
   std::string header;
   const auto gt = csvNumbers(dir.file("euroc") + "/mav0/state_groundtruth_estimate0/data.csv", &header);
   ASSERT_EQ(gt.size(), 3u);
@@ -190,6 +193,80 @@ TEST(EurocExport, UsesTheTrueImuStateAndWarnsAboutADroppedK3) {
   EXPECT_EQ(chain["distortion_coeffs"].size(), 4u);
   EXPECT_EQ(chain["resolution"][0].as<int>(), 240);
   EXPECT_THROW(exportEuroc(seq, dir.file("x"), {"nope"}), Error);
+  // A frames-only real recording (no sensors.yaml, no IMU): one error naming both.
+  fs::remove(seq + "/imu.txt");
+  fs::remove(seq + "/sensors.yaml");
+  try {
+    exportEuroc(seq, dir.file("y"));
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing: sensors.yaml, imu.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.file("y")));
+}
+
+/// A matrix given as rows of flow sequences, read as OpenVINS does through cv::FileStorage.
+Eigen::MatrixXd fileStorageRows(const cv::FileNode& node) {
+  std::vector<std::vector<double>> rows;
+  for (const auto& r : node) {
+    rows.emplace_back();
+    for (const auto& v : r) rows.back().push_back(static_cast<double>(v));
+  }
+  Eigen::MatrixXd M(rows.size(), rows.empty() ? 0 : rows[0].size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (std::size_t j = 0; j < rows[i].size(); ++j) M(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = rows[i][j];
+  return M;
+}
+
+TEST(EurocExport, EveryYamlFileIsReadByOpenCvsFileStorageAsPeersReadIt) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  fs::create_directories(seq);
+  const TestSequence s(seq);
+  const auto summary = exportEuroc(seq, dir.file("euroc"));
+  const std::string out = dir.file("euroc");
+  for (const char* f : {"camchain.yaml", "imu.yaml", "estimator_config.yaml", "evio_export.yaml", "mav0/body.yaml",
+                        "mav0/cam0/sensor.yaml", "mav0/imu0/sensor.yaml",
+                        "mav0/state_groundtruth_estimate0/sensor.yaml"}) {
+    SCOPED_TRACE(f);
+    EXPECT_EQ(io::readFile(out + "/" + f).rfind("%YAML:1.0\n", 0), 0u);
+    cv::FileStorage file(out + "/" + f, cv::FileStorage::READ);
+    ASSERT_TRUE(file.isOpened());
+    EXPECT_FALSE(file.root().empty());
+  }
+  // imu.yaml: what OpenVINS' kalibr IMU loader requires, with the sequence's values.
+  cv::FileStorage imu(out + "/imu.yaml", cv::FileStorage::READ);
+  const cv::FileNode imu0 = imu["imu0"];
+  EXPECT_EQ(static_cast<double>(imu0["gyroscope_noise_density"]), 0.00016);
+  EXPECT_EQ(static_cast<double>(imu0["accelerometer_noise_density"]), 0.0028);
+  EXPECT_EQ(static_cast<double>(imu0["update_rate"]), 200.0);
+  for (const char* m : {"Tw", "R_IMUtoGYRO", "Ta", "R_IMUtoACC"}) {
+    SCOPED_TRACE(m);
+    const Eigen::MatrixXd M = fileStorageRows(imu0[m]);
+    ASSERT_EQ(M.rows(), 3);
+    EXPECT_EQ(M, Eigen::MatrixXd(Mat3::Identity()));
+  }
+  EXPECT_EQ(fileStorageRows(imu0["Tg"]), Eigen::MatrixXd(Mat3::Zero()));
+  // camchain.yaml: T_cam_imu maps IMU points into the frame camera.
+  cv::FileStorage chain(out + "/camchain.yaml", cv::FileStorage::READ);
+  const Eigen::MatrixXd T_cam_imu = fileStorageRows(chain["cam0"]["T_cam_imu"]);
+  ASSERT_EQ(T_cam_imu.rows(), 4);
+  EXPECT_LT((T_cam_imu * s.rig.cameras[1].T_B_C.matrix() - Mat4::Identity()).norm(), 1e-12);
+  EXPECT_EQ(static_cast<double>(chain["cam0"]["intrinsics"][0]), 300.1);
+  EXPECT_EQ(static_cast<std::string>(chain["cam0"]["distortion_model"]), "equidistant");
+  // Gravity where OpenVINS reads it, and loudly everywhere else.
+  cv::FileStorage config(out + "/estimator_config.yaml", cv::FileStorage::READ);
+  EXPECT_EQ(static_cast<double>(config["gravity_mag"]), 3.721);
+  EXPECT_EQ(static_cast<std::string>(config["relative_config_imu"]), "imu.yaml");
+  EXPECT_EQ(static_cast<std::string>(config["relative_config_imucam"]), "camchain.yaml");
+  ASSERT_FALSE(summary.warnings.empty());
+  EXPECT_NE(summary.warnings.back().find("gravity is 3.721"), std::string::npos);
+  // EuRoC sensor blocks: T_BS as {cols, rows, data}.
+  cv::FileStorage cam(out + "/mav0/cam0/sensor.yaml", cv::FileStorage::READ);
+  EXPECT_EQ(static_cast<int>(cam["T_BS"]["rows"]), 4);
+  EXPECT_EQ(static_cast<double>(cam["T_BS"]["data"][3]), s.rig.cameras[1].T_B_C.translation().x());
+  cv::FileStorage gt(out + "/mav0/state_groundtruth_estimate0/sensor.yaml", cv::FileStorage::READ);
+  EXPECT_EQ(static_cast<std::string>(gt["sensor_type"]), "visual-inertial");
 }
 
 }  // namespace

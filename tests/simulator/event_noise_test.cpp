@@ -220,8 +220,8 @@ TEST(EventSensorPresets, LoadAndValidate) {
   EXPECT_EQ(dvx.height, 480);
   EXPECT_DOUBLE_EQ(dvx.event_camera.leak_rate_hz, 0.3);
   for (const auto* p : {&d240, &d346, &dvx}) {
-    EXPECT_GT(p->event_camera.cutoff_max_hz, 0.0) << p->name;
-    EXPECT_GT(p->event_camera.leak_rate_hz, 0.0) << p->name;
+    EXPECT_GT(p->event_camera.photoreceptorCutoffHz(1.0), 0.0) << p->name;  // every preset is band-limited
+    EXPECT_GT(p->event_camera.leak_rate_hz + p->event_camera.shot_noise_rate_hz, 0.0) << p->name;
     EXPECT_NO_THROW(EventCamera(p->width, p->height, p->event_camera, 1)) << p->name;
   }
   EXPECT_THROW(loadEventSensorPreset(dir + "/davis240c.yaml", {"event_camera.threshold_pos=-1"}), Error);

@@ -76,7 +76,7 @@ TEST(Scenario, OverridesReachPresetSections) {
                                   EVIO_SOURCE_DIR);
   EXPECT_EQ(s.end_ns - s.start_ns, 2 * kNsPerSecond);
   EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_pos, 0.3);
-  EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_neg, 0.2);  // kept from the preset
+  EXPECT_EQ(s.options.rig.event_camera.sensor.event_camera.threshold_neg, 0.38);  // kept from the preset
   EXPECT_EQ(s.scene.options.seed, 9u);
   const std::string yaml = s.resolvedYaml();
   EXPECT_NE(yaml.find("diameter_m: 2.5"), std::string::npos);
@@ -102,8 +102,14 @@ rig:
   EXPECT_NE(e.find("duration_s"), std::string::npos) << e;
   e = load("duration_s: 100\n");  // the hover preset lasts 60 s
   EXPECT_NE(e.find("past the end of the trajectory"), std::string::npos) << e;
-  e = load("  frame_camera: {rate_hz: 20, sensor: {auto_exposure_max_s: 0.1}}\n");
-  EXPECT_NE(e.find("auto_exposure_max_s"), std::string::npos) << e;
+  e = load("  frame_camera: {rate_hz: 20, sensor: {auto_exposure: false, exposure_s: 0.04, readout_s: 0.02}}\n");
+  EXPECT_NE(e.find("sensor.exposure_s"), std::string::npos) << e;
+  e = load("  frame_camera: {preset: simulator/presets/aps_davis240c.yaml, rate_hz: 24}\n");  // 5 + 41 ms > 1/24 s
+  EXPECT_NE(e.find("sensor.exposure_s"), std::string::npos) << e;
+  e = load("  frame_camera: {preset: simulator/presets/aps_davis240c.yaml, sensor: {shutter: diagonal}}\n");
+  EXPECT_NE(e.find("shutter"), std::string::npos) << e;
+  e = load("  frame_camera: {preset: simulator/presets/no_such_aps.yaml}\n");
+  EXPECT_NE(e.find("no_such_aps.yaml"), std::string::npos) << e;
   e = errorOf([&] {
     loadScenarioString(base + "  range_finder: {enabled: true, T_B_L: [1,0,0,0, 0,1,0,0, 0,0,2,0, 0,0,0,1]}\n",
                        "bad.yaml", "", {}, EVIO_SOURCE_DIR);
@@ -122,6 +128,33 @@ rig:
                        "bad.yaml", "", {}, EVIO_SOURCE_DIR);
   });
   EXPECT_FALSE(e.empty());
+}
+
+TEST(Scenario, FrameCameraPresetLiesUnderTheScenariosKeys) {
+  const std::string text = R"(
+scene: scenes/presets/ec_shapes.yaml
+trajectory: trajectories/presets/hover.yaml
+rig:
+  event_camera: {preset: simulator/presets/davis240c.yaml}
+  frame_camera:
+    preset: simulator/presets/aps_davis240c.yaml
+    rate_hz: 20
+    sensor: {exposure_s: 0.003}
+)";
+  const Scenario s = loadScenarioString(text, "s.yaml", "", {"rig.frame_camera.sensor.shutter=rolling"}, EVIO_SOURCE_DIR);
+  const auto& sensor = s.options.rig.frame_camera.sensor;
+  EXPECT_EQ(sensor.exposure_s, 0.003);       // the scenario's key
+  EXPECT_EQ(sensor.shutter, "rolling");      // the override
+  EXPECT_EQ(sensor.full_well_e, 10350.0);    // the preset's
+  EXPECT_EQ(sensor.dark_offset_dn, -16.7);
+  EXPECT_FALSE(sensor.auto_exposure);
+  // The resolved scenario holds every sensor key inline and no preset.
+  const std::string yaml = s.resolvedYaml();
+  EXPECT_NE(yaml.find("saturation_dn: 131.3"), std::string::npos);
+  const Scenario again = loadScenarioString(yaml, "resolved.yaml", "", {}, EVIO_SOURCE_DIR);
+  EXPECT_EQ(again.options.rig.frame_camera.sensor.full_well_e, 10350.0);
+  EXPECT_EQ(again.options.rig.frame_camera.sensor.shutter, "rolling");
+  EXPECT_TRUE(again.options.rig.frame_camera.preset.empty());
 }
 
 TEST(Scenario, InlineSectionsNeedNoPresetFiles) {

@@ -9,7 +9,9 @@
 #include "evio/core/error.h"
 #include "evio/core/so3.h"
 #include "evio/trajectories/flight.h"
+#include "evio/trajectories/hand_held.h"
 #include "evio/trajectories/hover.h"
+#include "evio/trajectories/rotation_only.h"
 #include "evio/trajectories/trajectory_factory.h"
 #include "trajectory_presets.h"
 
@@ -158,6 +160,32 @@ TEST(Presets, RotationOnlyHasExactlyZeroTranslation) {
   // "Peak rates of several hundred deg/s", as in the dataset's rotation sequences.
   EXPECT_GT(peak_rate * kRadToDeg, 300.0);
   EXPECT_LT(peak_rate * kRadToDeg, 1500.0);
+}
+
+TEST(Presets, OnsetStartsAtRestAndEndsOnTheOscillation) {
+  // onset_s = T multiplies every axis by the C∞ smoothstep S(t/T): at t = 0
+  // the pose is the rest pose and every rate is exactly 0; for t ≥ T the
+  // motion is the one without onset, exactly (S = 1 there).
+  RotationOnlyOptions rot = config::load<RotationOnlyOptions>(test::trajectoryPresetPath("rotation_only.yaml"));
+  HandHeldOptions six = config::load<HandHeldOptions>(test::trajectoryPresetPath("six_dof.yaml"));
+  const RotationOnlyTrajectory rot_free(rot);
+  const HandHeldTrajectory six_free(six);
+  rot.onset_s = six.onset_s = 2.0;
+  const RotationOnlyTrajectory rot_onset(rot);
+  const HandHeldTrajectory six_onset(six);
+  for (const auto* traj : {static_cast<const ContinuousTrajectory*>(&rot_onset), static_cast<const ContinuousTrajectory*>(&six_onset)}) {
+    const TrajectoryState s0 = traj->evaluate(0);
+    EXPECT_EQ(s0.omega_B, Vec3::Zero());
+    EXPECT_EQ(s0.v_W, Vec3::Zero());
+    EXPECT_EQ(s0.alpha_B, Vec3::Zero());
+    EXPECT_EQ(s0.a_W, Vec3::Zero());
+  }
+  for (TimeNs t = 2000 * kNsPerMs; t <= 3000 * kNsPerMs; t += 100 * kNsPerMs) {
+    EXPECT_LT((rot_onset.evaluate(t).omega_B - rot_free.evaluate(t).omega_B).norm(), 1e-12);
+    EXPECT_LT((six_onset.evaluate(t).v_W - six_free.evaluate(t).v_W).norm(), 1e-12);
+  }
+  rot.onset_s = -1.0;
+  EXPECT_THROW(rot.validate(), Error);
 }
 
 TEST(Presets, HoverStaysWithinItsStatedBox) {

@@ -18,6 +18,7 @@ void HandHeldOptions::validate() const {
   requirePositive("frequency_start_hz", frequency_start_hz);
   requirePositive("frequency_end_hz", frequency_end_hz);
   requireInRange("frequency_spread", frequency_spread, 0.0, 0.5);
+  requireInRange("onset_s", onset_s, 0.0, duration_s);
 }
 
 namespace {
@@ -31,6 +32,7 @@ motion::Chirp drawChirp(RandomStream& rng, const HandHeldOptions& o, double a0, 
   c.frequency_end_hz = m * o.frequency_end_hz;
   c.duration_s = o.duration_s;
   c.phase_rad = rng.uniform(0.0, 2.0 * std::numbers::pi);
+  c.onset_s = o.onset_s;
   return c;
 }
 

@@ -15,6 +15,7 @@ void RotationOnlyOptions::validate() const {
   requirePositive("frequency_start_hz", frequency_start_hz);
   requirePositive("frequency_end_hz", frequency_end_hz);
   requireInRange("frequency_spread", frequency_spread, 0.0, 0.5);
+  requireInRange("onset_s", onset_s, 0.0, duration_s);
 }
 
 RotationOnlyTrajectory::RotationOnlyTrajectory(const RotationOnlyOptions& options)
@@ -30,6 +31,7 @@ RotationOnlyTrajectory::RotationOnlyTrajectory(const RotationOnlyOptions& option
     c.frequency_end_hz = m * options_.frequency_end_hz;
     c.duration_s = options_.duration_s;
     c.phase_rad = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    c.onset_s = options_.onset_s;
   }
 }
 

@@ -4,25 +4,35 @@
 
 #include "evio/core/error.h"
 #include "evio/estimator/frontend/eklt_tracker.h"
+#include "evio/estimator/frontend/haste_tracker.h"
 
 namespace evio::estimator {
 
+namespace {
+
+/// Runs a nested validate() and prefixes its message with the section name
+/// ("haste.margin: ...", so a message names the key as it is set).
+template <class Options>
+void validateSection(const char* section, const Options& options) {
+  try {
+    options.validate();
+  } catch (const Error& e) {
+    throw Error(std::string(section) + "." + e.what());
+  }
+}
+
+}  // namespace
+
 void FrontendOptions::validate() const {
-  requireField(tracker == "eklt" || tracker == "klt", "tracker", "must be eklt or klt (got '" + tracker + "')");
+  requireField(tracker == "eklt" || tracker == "klt" || tracker == "haste", "tracker",
+               "must be eklt, klt or haste (got '" + tracker + "')");
   requireField(image_source == "frames" || image_source == "reconstructed", "image_source",
                "must be frames or reconstructed (got '" + image_source + "')");
-  // Each section's errors carry its name: eklt.max_features, not max_features.
-  const auto section = [](const char* name, const auto& options) {
-    try {
-      options.validate();
-    } catch (const Error& e) {
-      throw Error(std::string(name) + "." + e.what());
-    }
-  };
-  section("prefilter", prefilter);
-  section("eklt", eklt);
-  section("klt", klt);
-  section("reconstruction", reconstruction);
+  validateSection("prefilter", prefilter);
+  validateSection("eklt", eklt);
+  validateSection("klt", klt);
+  validateSection("haste", haste);
+  validateSection("reconstruction", reconstruction);
 }
 
 Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
@@ -30,6 +40,8 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
   options_.validate();
   if (options_.tracker == "eklt")
     tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C);
+  else if (options_.tracker == "haste")
+    tracker_ = std::make_unique<HasteTracker>(options_.haste, camera);
   else
     tracker_ = std::make_unique<KltTracker>(options_.klt, camera);
   if (options_.image_source == "reconstructed")

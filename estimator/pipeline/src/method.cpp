@@ -5,9 +5,10 @@
 namespace evio::estimator {
 
 namespace {
-constexpr std::array<MethodInfo, 3> kMethods{{
+constexpr std::array<MethodInfo, 4> kMethods{{
     {Method::kEkltVio, "eklt-vio", "eklt", "events", true, false},
     {Method::kKltVio, "klt-vio", "klt", "track_time", false, true},
+    {Method::kHasteVio, "haste-vio", "haste", "events", true, false},
     {Method::kTracks, "tracks", "", "events", false, false},
 }};
 }  // namespace

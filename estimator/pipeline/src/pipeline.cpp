@@ -116,7 +116,8 @@ void PipelineRun::setup() {
   if (!fs::is_directory(sequence_)) throw Error(sequence_ + ": not a folder");
   method_ = options_.methodKind();
   const MethodInfo& method = methodInfo(method_);
-  const bool eklt = method_ == Method::kEkltVio;
+  // Event trackers seeded on frames: EKLT and HASTE.
+  const bool eklt = method_ == Method::kEkltVio || method_ == Method::kHasteVio;
 
   // Frames: needed by KLT and by EKLT on sensor frames; fused into the reconstruction when present.
   const bool has_images = fs::exists(fs::path(sequence_) / "images.txt");

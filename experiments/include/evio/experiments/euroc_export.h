@@ -21,8 +21,15 @@
 ///       cam0: T_cam_imu (= T_B_C⁻¹: maps IMU points into the camera), camera_model,
 ///       intrinsics, distortion_model/coeffs, resolution, rostopic, timeshift_cam_imu
 ///   <out>/imu.yaml                Kalibr IMU (OpenVINS' kalibr_imu_chain.yaml): imu0 noise
-///       densities and random walks, update_rate
+///       densities and random walks, update_rate, and the intrinsics OpenVINS
+///       requires (Tw, R_IMUtoGYRO, Ta, R_IMUtoACC identity; Tg zero)
+///   <out>/estimator_config.yaml   OpenVINS: gravity_mag (the sequence's gravity) and the
+///       paths of imu.yaml and camchain.yaml
+///   <out>/mav0/body.yaml, mav0/state_groundtruth_estimate0/sensor.yaml   as in EuRoC
 ///   <out>/evio_export.yaml        what was exported from where, gravity, warnings
+/// Every YAML file starts with "%YAML:1.0" as EuRoC's do, so OpenCV's
+/// cv::FileStorage (OpenVINS, VINS) reads it. A gravity other than 9.81 m/s²
+/// is a warning: EuRoC has no field for it and peers assume Earth's.
 /// cam0 is the first frame camera of sensors.yaml (or the one named by
 /// options.camera). Kalibr's radtan has four coefficients: a non-zero k3 is
 /// dropped with a warning. Memory stays flat: IMU and ground truth stream.

@@ -6,16 +6,32 @@
 ///
 /// Per pixel i, for a sample (t, I) with I the radiance in W/(m²·sr):
 ///
-///  1. Log radiance  L_in = log(ε + max(I, 0))     (NaN radiance counts as 0).
-///  2. Photoreceptor low-pass (when cutoff_max_hz > 0): first order,
-///       τ dL_f/dt = L_in(t) − L_f,   τ = 1 / (2π f_c(I)),
-///       f_c(I) = f_min + (f_max − f_min) · I / (I + I_ref),
+///  1. Log input. bandwidth_model "radiance" (the legacy model):
+///       L_in = log(ε + max(I, 0))     (NaN radiance counts as 0).
+///     bandwidth_model "photocurrent": the photodiode current through the
+///     optics (on-axis camera equation, one wavelength λ, as frame_camera.h),
+///       I_ph = k · I,   k = q · QE · A_pd · λ/(h c) · π T / (4 N²)   [A per W/(m²·sr)]
+///     (N the f-number, T the lens transmission, A_pd the photodiode area,
+///     QE the quantum efficiency), and the log of photo plus dark current,
+///       L_in = log(I_ph + I_dark) = log k + log(ε + I),   ε = I_dark / k;
+///     the constant log k cancels in every threshold comparison, so the
+///     pixel runs on log(ε + I) with that physical ε.
+///  2. Bandwidth: the photoreceptor is a first-order low-pass
+///       τ dL_p/dt = L_in(t) − L_p,   τ = 1 / (2π f_c(I)),
 ///     solved exactly for L_in linear between the two samples and f_c held at
 ///     the newer sample's value over the interval (x = Δt/τ):
-///       L_f(t1) = L_in(t1) + (L_f(t0) − L_in(t0)) e^(−x) − ΔL_in (1 − e^(−x)) / x.
-///     In the dark f_c → f_min, so events lag and thin out (v2e scales the
-///     cut-off linearly with intensity; this form is linear for I ≪ I_ref and
-///     saturates at f_max in bright light). Without it L_f = L_in.
+///       L_p(t1) = L_in(t1) + (L_p(t0) − L_in(t0)) e^(−x) − ΔL_in (1 − e^(−x)) / x.
+///     "radiance": f_c(I) = f_min + (f_max − f_min) · I / (I + I_ref), the
+///     legacy knob (none when cutoff_max_hz = 0: L_p = L_in).
+///     "photocurrent": f_c = κ · (I_ph + I_dark), the adaptive photoreceptor's
+///     pole proportional to the photocurrent (Delbruck & Mead 1994;
+///     Lichtsteiner, Posch & Delbruck, IEEE JSSC 2008: bandwidth rises with
+///     illumination, 3 kHz at 1 klux), κ = photoreceptor_hz_per_pa. So
+///     lag grows as 1/I in the dark.
+///     Then, when source_follower_hz > 0, the source-follower buffer: a second
+///     first-order low-pass of fixed cut-off f_sf (set by its bias, not by the
+///     light) from L_p to L_f, by the same formula with L_p taken linear
+///     between samples. Without it L_f = L_p.
 ///  3. Events: the pixel stores a reference r. While L_f(t1) ≥ r + C⁺_k:
 ///     r += C⁺_k and an ON event is timed where the straight line from
 ///     (t0, L_f(t0)) to (t1, L_f(t1)) crosses r (rounded to ns, kept in
@@ -24,25 +40,38 @@
 ///  4. Thresholds: C^±_i = max(C_min, C^± + σ_m z^±_i), z fixed per pixel
 ///     (stream "event_threshold_mismatch"); with jitter σ_j > 0 the threshold
 ///     of crossing k is max(C_min, C^±_i + σ_j z^±_{i,k}) ("event_jitter").
-///  5. Refractory period: a crossing less than refractory_period_s after the
+///  5. Refractory period R_i = R · exp(σ_R z_i), z_i fixed per pixel
+///     ("event_refractory_mismatch"; σ_R = 0: every pixel R), the spread of
+///     the pixel's refractory transistor: a crossing less than R_i after the
 ///     pixel's last emitted signal event moves r but emits nothing.
-///  6. Noise, independent of the pixel's reference (noise events neither move
-///     r nor start a refractory period), each with its own label:
+///  6. Noise, independent of the pixel's reference (noise events do not move
+///     r), each with its own label. Shot events reset the pixel like signal
+///     events: none is emitted within refractory_period_s of the pixel's last
+///     emitted event (either side), and an emitted one starts a refractory
+///     period. Leak and hot-pixel events ignore the refractory period:
 ///     - leak: ON events, Poisson at leak_rate_hz per pixel ("event_leak");
 ///     - shot: ON or OFF with equal probability, Poisson per pixel at
 ///         r_shot(I) = R_shot (1 − (1 − b) · I / (I + I_ref)),
 ///       R_shot in the dark, b·R_shot in bright light (v2e's linear
 ///       intensity dependence, its b = 0.25), the rate held at the newer
-///       sample's value over each interval ("event_shot_noise");
+///       sample's value over each interval ("event_shot_noise"); with the
+///       "photocurrent" model I_ref = shot_noise_reference_pa / k;
 ///     - hot pixels: round(fraction · N) pixels chosen once emit ON events,
 ///       Poisson at hot_pixel_rate_hz each ("event_hot_pixels").
+///
+///  7. Background-activity filter (ba_filter_window_s > 0): every event,
+///     in output order, passes the DAVIS hardware filter of
+///     background_activity_filter.h (support from one of the 8 neighbours
+///     within the window) or is dropped with its label.
 ///
 /// Determinism: every per-pixel draw is counterHash(stream key, pixel,
 /// counter) (counter_rng.h), so it does not depend on the order pixels are
 /// processed in or on the thread count. Leak and hot-pixel events depend on
 /// time alone: the superposition of N Poisson processes of rate r is one of
 /// rate N·r with a uniformly drawn pixel, drawn from a sequential stream.
-/// Memory is flat: 48 bytes of state per pixel plus the events pending.
+/// Memory is flat: 48 bytes of state per pixel (+4 with the source
+/// follower, +8 with the BA filter, +8 with a refractory spread) plus the
+/// events pending.
 ///
 /// How to drive it from a render loop:
 ///  - Whole frames: `update(t, radiance, &events, &labels)` once per render
@@ -61,13 +90,16 @@
 ///  a total order, so the stream does not depend on the thread count.
 
 #include <cstdint>
+#include <memory>
 #include <opencv2/core/mat.hpp>
+#include <string>
 #include <vector>
 
 #include "evio/core/event.h"
 #include "evio/core/options.h"
 #include "evio/core/random_stream.h"
 #include "evio/core/time.h"
+#include "evio/simulator/background_activity_filter.h"
 
 namespace evio::simulator {
 
@@ -90,11 +122,23 @@ class EventCamera {
     double threshold_mismatch_sigma = 0.03; ///< σ_m of the fixed per-pixel threshold offset, log units
     double threshold_jitter_sigma = 0.0;    ///< σ_j of the per-crossing threshold noise, log units
     double threshold_min = 0.01;            ///< C_min, lower clamp of every threshold, log units
-    double refractory_period_s = 0.0;       ///< dead time after an emitted signal event, s
+    double refractory_period_s = 0.0;       ///< dead time after an emitted signal or shot event, s
+    double refractory_mismatch_sigma = 0.0; ///< σ_R of the per-pixel log refractory period
     double log_eps_w_m2_sr = 1e-3;          ///< ε of L = log(ε + I), W/(m²·sr)
     double cutoff_max_hz = 0.0;             ///< photoreceptor cut-off in bright light, Hz; 0 = ideal (no filter)
     double cutoff_min_hz = 1.0;             ///< cut-off floor in the dark, Hz
-    double reference_radiance_w_m2_sr = 1.0;///< I_ref: where bandwidth and shot noise are half-way to bright
+    double reference_radiance_w_m2_sr = 1.0;///< I_ref: where bandwidth and shot noise are half-way to bright ("radiance")
+    std::string bandwidth_model = "radiance"; ///< "radiance" (legacy f_c(I)) or "photocurrent" (f_c ∝ I_ph)
+    double f_number = 2.0;                  ///< N of the lens ("photocurrent")
+    double lens_transmission = 0.9;         ///< T of the lens ("photocurrent")
+    double photodiode_area_um2 = 75.0;      ///< A_pd: photosensitive area of one pixel, µm² ("photocurrent")
+    double quantum_efficiency = 0.3;        ///< QE of the photodiode ("photocurrent")
+    double wavelength_nm = 550.0;           ///< λ of the one-wavelength photon model, nm ("photocurrent")
+    double dark_current_fa = 4.0;           ///< I_dark of the photodiode, fA ("photocurrent")
+    double photoreceptor_hz_per_pa = 800.0; ///< κ: photoreceptor cut-off per pA of photocurrent ("photocurrent")
+    double shot_noise_reference_pa = 1.0;   ///< photocurrent where shot noise is half-way to bright ("photocurrent")
+    double source_follower_hz = 0.0;        ///< f_sf: fixed cut-off of the source-follower buffer, Hz; 0 = none
+    double ba_filter_window_s = 0.0;        ///< T of the background-activity filter, s; 0 = off
     double leak_rate_hz = 0.0;              ///< leak events per pixel per second
     double shot_noise_rate_hz = 0.0;        ///< R_shot: shot-noise events per pixel per second in the dark
     double shot_noise_bright_factor = 0.25; ///< b: rate in bright light as a fraction of R_shot
@@ -110,10 +154,22 @@ class EventCamera {
       v("threshold_jitter_sigma", threshold_jitter_sigma, "per-crossing threshold sigma, log units");
       v("threshold_min", threshold_min, "lower clamp of thresholds, log units");
       v("refractory_period_s", refractory_period_s, "refractory period, s");
+      v("refractory_mismatch_sigma", refractory_mismatch_sigma, "per-pixel sigma of log refractory period");
       v("log_eps_w_m2_sr", log_eps_w_m2_sr, "epsilon of log(eps + I), W/(m^2 sr)");
       v("cutoff_max_hz", cutoff_max_hz, "photoreceptor cut-off in bright light, Hz (0 = ideal)");
       v("cutoff_min_hz", cutoff_min_hz, "photoreceptor cut-off floor in the dark, Hz");
       v("reference_radiance_w_m2_sr", reference_radiance_w_m2_sr, "half-way radiance I_ref, W/(m^2 sr)");
+      v("bandwidth_model", bandwidth_model, "radiance (legacy) or photocurrent");
+      v("f_number", f_number, "lens f-number (photocurrent model)");
+      v("lens_transmission", lens_transmission, "lens transmission (photocurrent model)");
+      v("photodiode_area_um2", photodiode_area_um2, "photodiode area, um^2 (photocurrent model)");
+      v("quantum_efficiency", quantum_efficiency, "quantum efficiency (photocurrent model)");
+      v("wavelength_nm", wavelength_nm, "photon wavelength, nm (photocurrent model)");
+      v("dark_current_fa", dark_current_fa, "photodiode dark current, fA (photocurrent model)");
+      v("photoreceptor_hz_per_pa", photoreceptor_hz_per_pa, "photoreceptor cut-off per pA, Hz/pA");
+      v("shot_noise_reference_pa", shot_noise_reference_pa, "half-way photocurrent of shot noise, pA");
+      v("source_follower_hz", source_follower_hz, "source-follower cut-off, Hz (0 = none)");
+      v("ba_filter_window_s", ba_filter_window_s, "background-activity filter window, s (0 = off)");
       v("leak_rate_hz", leak_rate_hz, "leak events per pixel per second");
       v("shot_noise_rate_hz", shot_noise_rate_hz, "shot noise per pixel per second in the dark");
       v("shot_noise_bright_factor", shot_noise_bright_factor, "bright/dark shot noise rate ratio");
@@ -122,6 +178,13 @@ class EventCamera {
       v("threads", threads, "threads, 0 = all cores");
     }
     void validate() const;
+    bool photocurrentModel() const { return bandwidth_model == "photocurrent"; }
+    /// k: photocurrent per unit radiance, pA per W/(m²·sr) ("photocurrent").
+    double photocurrentPerRadiancePa() const;
+    /// ε of L = log(ε + I), W/(m²·sr): log_eps_w_m2_sr, or I_dark / k ("photocurrent").
+    double logEpsilon() const;
+    /// Photoreceptor cut-off at radiance I, Hz (before the source follower); 0 = no filter.
+    double photoreceptorCutoffHz(double radiance_w_m2_sr) const;
   };
 
   /// A camera of width × height pixels (pixel index i = y·width + x).
@@ -162,11 +225,17 @@ class EventCamera {
   TimeNs lastSampleTime(std::size_t i) const { return uniform_ ? uniform_t_ : t_prev_[i]; }
   /// Reference level r of pixel i (log units).
   float reference(std::size_t i) const { return ref_[i]; }
+  /// Log input L_p after the photoreceptor (before the source follower) at the last sample of pixel i.
+  float photoreceptorLog(std::size_t i) const { return follower_ ? lpr_prev_[i] : lf_prev_[i]; }
+  /// Events the background-activity filter dropped so far.
+  std::uint64_t baDropped() const { return ba_dropped_; }
   /// Filtered log radiance L_f at the last sample of pixel i.
   float filteredLog(std::size_t i) const { return lf_prev_[i]; }
   /// The pixel's fixed thresholds C^±_i (before per-crossing jitter).
   float thresholdPos(std::size_t i) const;
   float thresholdNeg(std::size_t i) const;
+  /// The refractory period of pixel i, ns.
+  TimeNs refractoryNs(std::size_t i) const { return refractory_px_.empty() ? refractory_ns_ : refractory_px_[i]; }
   /// Whether pixel i is hot.
   bool isHot(std::size_t i) const;
   /// Events waiting in the pending buffer.
@@ -198,15 +267,17 @@ class EventCamera {
   Options options_;
   std::uint64_t key_mismatch_ = 0, key_jitter_ = 0, key_shot_ = 0;
   bool initialized_ = false;
-  bool bandwidth_ = false, shot_ = false, jitter_ = false;
+  bool bandwidth_ = false, follower_ = false, shot_ = false, jitter_ = false;
   TimeNs refractory_ns_ = 0;
+  std::vector<TimeNs> refractory_px_;   ///< per-pixel refractory period (empty when σ_R = 0)
   TimeNs t_init_ = 0;
 
   // Per-pixel state (structure of arrays).
   std::vector<TimeNs> t_prev_;          ///< last sample time
-  std::vector<TimeNs> t_last_event_;    ///< last emitted signal event (refractory)
+  std::vector<TimeNs> t_last_event_;    ///< last emitted signal or shot event (refractory)
   std::vector<float> lin_prev_;         ///< L_in at the last sample
   std::vector<float> lf_prev_;          ///< L_f at the last sample
+  std::vector<float> lpr_prev_;         ///< L_p at the last sample (source follower only)
   std::vector<float> ref_;              ///< reference r
   std::vector<float> th_pos_, th_neg_;  ///< thresholds of the next crossing
   std::vector<float> shot_budget_;      ///< remaining Exp(1) hazard to the next shot event
@@ -223,6 +294,9 @@ class EventCamera {
   double next_leak_ns_ = 0.0, next_hot_ns_ = 0.0;
   std::vector<std::uint32_t> hot_pixels_;   ///< sorted indices of hot pixels
   TimeNs noise_done_ns_ = 0;                ///< timed noise generated up to here
+
+  std::unique_ptr<BackgroundActivityFilter> ba_filter_;  ///< null when off
+  std::uint64_t ba_dropped_ = 0;
 
   std::vector<Pending> pending_;
   std::vector<std::uint64_t> sort_keys_, sort_scratch_;

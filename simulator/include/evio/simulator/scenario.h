@@ -13,7 +13,7 @@
 ///   trajectory: <path> | {preset: <path>, <keys replaced>} | {<inline trajectory>}
 ///   rig:
 ///     event_camera: {preset: <simulator/presets/*.yaml>, <EventCameraRigOptions keys>}
-///     frame_camera: {...}       # FrameCameraRigOptions
+///     frame_camera: {preset: <simulator/presets/aps_*.yaml>, sensor: {...}, ...}  # FrameCameraRigOptions
 ///     imu: {...}                # ImuSimulator::Options, Kalibr names
 ///     range_finder: {...}       # RangeFinderRigOptions
 ///   sampling: {...}             # RenderScheduleOptions
@@ -23,7 +23,8 @@
 /// `search_root` (the repository, so `scenes/presets/mars_yard.yaml` works
 /// from anywhere). A `{preset: ...}` map loads the preset and replaces the
 /// keys given beside `preset` (event_camera: merged key by key, nested maps
-/// included; lists are replaced whole). Unknown keys are an error naming the
+/// included; lists are replaced whole; frame_camera: the preset fills
+/// `sensor`, under the keys of `sensor:`). Unknown keys are an error naming the
 /// file and line; `--set` overrides (`rig.imu.update_rate_hz=200`,
 /// `trajectory.center_m=[0,0,2]`, `duration_s=2`) apply before resolving.
 ///
@@ -70,16 +71,22 @@ struct EventCameraRigOptions {
 };
 
 /// The frame camera: the event camera's own pixels (DAVIS APS frames,
-/// `co_located`) or a separate camera with its own lens and mounting.
+/// `co_located`) or a separate camera with its own lens and mounting. Its
+/// sensor's defaults may come from a preset file (simulator/presets/aps_*.yaml:
+/// the FrameCamera::Options keys, each with its source), over which the keys
+/// of `sensor:` are merged.
 struct FrameCameraRigOptions {
+  std::string preset;                 ///< frame sensor preset file (defaults of `sensor`); "" = none
   bool enabled = true;                ///< write images.txt and images/
   bool co_located = true;             ///< frames from the event pixels (same camera, pose and renders)
   double rate_hz = 20.0;              ///< frame rate: exposure k starts at start + k / rate_hz
-  int exposure_samples = 3;           ///< N renders evenly over the exposure, both ends (motion blur)
+  int exposure_samples = 3;           ///< N renders evenly over the frame's span, both ends (motion blur, rolling shutter)
   /// Meter the first exposure on a render of the first view: the exposure
   /// whose noise-free mean DN/255 is the auto-exposure target,
   /// t = (target^γ · full_well) / (K · mean radiance), within the exposure
-  /// limits (frame_camera.h); otherwise start at sensor.exposure_s.
+  /// limits (frame_camera.h); otherwise start at sensor.exposure_s. Only
+  /// with auto-exposure on (either method: it stands in for an operator
+  /// setting a first exposure for the scene); a fixed exposure stays fixed.
   bool meter_first_exposure = true;
   std::string name = "frames";        ///< camera name in sensors.yaml
   // A separate camera only (co_located = false):
@@ -89,10 +96,13 @@ struct FrameCameraRigOptions {
   Vec4 intrinsics = Vec4(470.0, 470.0, 375.5, 239.5);  ///< fx fy cx cy, px
   std::vector<double> distortion;     ///< as Camera::create
   Mat4 T_B_F = Mat4::Identity();      ///< frame camera F into body B, row-major 4×4
-  FrameCamera::Options sensor;        ///< exposure, auto-exposure, noise
+  /// Exposure, auto-exposure, readout, noise. The auto-exposure never goes
+  /// past 1 / rate_hz − sensor.readout_s.
+  FrameCamera::Options sensor;
 
   template <class V>
   void fields(V& v) {
+    v("preset", preset, "frame sensor preset file (defaults of sensor.*)");
     v("enabled", enabled, "write frames");
     v("co_located", co_located, "frames from the event camera's pixels (DAVIS APS)");
     v("rate_hz", rate_hz, "frame rate, Hz");

@@ -46,6 +46,8 @@ struct HandHeldOptions : TrajectoryCommonOptions {
   double frequency_end_hz = 1.2;
   /// Relative spread of the per-axis frequency multipliers, in [0, 0.5].
   double frequency_spread = 0.2;
+  /// Fade-in from rest over [0, onset_s] (C∞ smoothstep on every axis), s; 0 = none.
+  double onset_s = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -59,6 +61,7 @@ struct HandHeldOptions : TrajectoryCommonOptions {
     v("frequency_start_hz", frequency_start_hz, "oscillation frequency at the start, Hz");
     v("frequency_end_hz", frequency_end_hz, "oscillation frequency at the end, Hz");
     v("frequency_spread", frequency_spread, "relative spread of per-axis frequencies");
+    v("onset_s", onset_s, "fade-in from rest, s (0 = none)");
   }
   void validate() const;
 };

@@ -80,6 +80,8 @@ class Wobble {
 /// A chirped oscillation whose amplitude and frequency ramp linearly over
 /// [0, T]:  x(t) = A(t) sin(Φ(t) + φ0),  A(t) = A0 + (A1 − A0) t/T,
 /// Φ(t) = 2π ∫₀ᵗ f = 2π (f0 t + (f1 − f0) t² / (2T)). C∞; |x| ≤ max(A0, A1).
+/// With onset_s > 0 the oscillation fades in from rest: x(t) · S(t / onset_s)
+/// (S the C∞ smoothstep), so x and all its derivatives are 0 at t = 0.
 struct Chirp {
   double amplitude_start = 0.0;
   double amplitude_end = 0.0;
@@ -87,9 +89,16 @@ struct Chirp {
   double frequency_end_hz = 0.0;
   double duration_s = 1.0;
   double phase_rad = 0.0;
+  double onset_s = 0.0;
 
   template <int N>
   taylor::Scalar<N> operator()(const taylor::Scalar<N>& t) const {
+    if (onset_s > 0.0) return oscillation(t) * smoothStep((1.0 / onset_s) * t);
+    return oscillation(t);
+  }
+
+  template <int N>
+  taylor::Scalar<N> oscillation(const taylor::Scalar<N>& t) const {
     const double T = duration_s;
     const taylor::Scalar<N> amplitude = amplitude_start + ((amplitude_end - amplitude_start) / T) * t;
     const taylor::Scalar<N> phase =

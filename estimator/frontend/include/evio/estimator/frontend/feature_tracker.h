@@ -1,6 +1,6 @@
 #pragma once
 /// @file feature_tracker.h
-/// The interface every frontend tracker implements (EKLT, KLT), so that the
+/// The interface every frontend tracker implements (EKLT, KLT, HASTE), so that the
 /// synchronizer and the backend pipelines treat them alike.
 ///
 /// Inputs must come in time order across all three streams: the caller
@@ -41,7 +41,7 @@ class FeatureTracker {
   /// Number of tracks currently alive (being tracked).
   virtual std::size_t numAlive() const = 0;
 
-  /// "eklt" or "klt".
+  /// "eklt", "klt" or "haste".
   virtual std::string_view name() const = 0;
 };
 

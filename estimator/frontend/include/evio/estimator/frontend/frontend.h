@@ -1,7 +1,7 @@
 #pragma once
 /// @file frontend.h
 /// The frontend as the pipelines and `evio track` use it: an optional
-/// event-based image reconstruction and one tracker (EKLT or KLT) behind the
+/// event-based image reconstruction and one tracker (EKLT, KLT or HASTE) behind the
 /// FeatureTracker interface. Inputs in time order (feature_tracker.h). The
 /// event pre-filters (event_prefilter.h, options `prefilter`) run before it:
 /// the pipeline's PrefilterStage, or the caller.
@@ -15,26 +15,29 @@
 #include "evio/estimator/frontend/eklt_options.h"
 #include "evio/estimator/frontend/event_prefilter.h"
 #include "evio/estimator/frontend/feature_tracker.h"
+#include "evio/estimator/frontend/haste_options.h"
 #include "evio/estimator/frontend/image_reconstructor.h"
 #include "evio/estimator/frontend/klt_tracker.h"
 
 namespace evio::estimator {
 
 struct FrontendOptions {
-  std::string tracker = "eklt";          ///< eklt | klt
+  std::string tracker = "eklt";          ///< eklt | klt | haste
   std::string image_source = "frames";   ///< frames | reconstructed (from events)
   EventPrefilterOptions prefilter;  ///< for the pre-filter that runs before the frontend
   EkltOptions eklt;
   KltOptions klt;
+  HasteOptions haste;
   ImageReconstructorOptions reconstruction;
 
   template <class V>
   void fields(V& v) {
-    v("tracker", tracker, "eklt or klt");
+    v("tracker", tracker, "eklt, klt or haste");
     v("image_source", image_source, "frames or reconstructed");
     v("prefilter", prefilter, "event pre-filters");
     v("eklt", eklt, "EKLT tracker");
     v("klt", klt, "KLT tracker");
+    v("haste", haste, "HASTE tracker");
     v("reconstruction", reconstruction, "event-based image reconstruction");
   }
   void validate() const;
@@ -42,7 +45,7 @@ struct FrontendOptions {
 
 class Frontend {
  public:
-  /// `camera` is the event camera (EKLT) or frame camera (KLT); `T_B_C` is
+  /// `camera` is the event camera (EKLT, HASTE) or frame camera (KLT); `T_B_C` is
   /// needed for the EKLT gyro prediction only.
   Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
   ~Frontend();

@@ -13,6 +13,7 @@ namespace evio::estimator {
 enum class Method {
   kEkltVio,  ///< EKLT on events and frames (or frames reconstructed from events)
   kKltVio,   ///< KLT on the frames, one backend update per frame
+  kHasteVio, ///< HASTE on events (seeded on frames or frames reconstructed from events)
   kTracks,   ///< no frontend: feature tracks read from a file (the backend in isolation)
 };
 
@@ -29,7 +30,7 @@ struct MethodInfo {
 const MethodInfo& methodInfo(Method method);
 /// The method named `name`; nullopt for an unknown name.
 std::optional<Method> parseMethod(std::string_view name);
-/// "eklt-vio, klt-vio, tracks" (for messages and the CLI).
+/// "eklt-vio, klt-vio, haste-vio, tracks" (for messages and the CLI).
 std::string methodNames();
 
 }  // namespace evio::estimator

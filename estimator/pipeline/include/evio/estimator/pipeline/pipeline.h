@@ -24,9 +24,10 @@
 /// or a status in status.yaml — never a crash):
 ///  - events out of order, malformed files: evio::Error from the readers,
 ///    naming file and line (or HDF5 index);
-///  - no frames (images.txt missing or empty): eklt-vio with
+///  - no frames (images.txt missing or empty): eklt-vio and haste-vio with
 ///    frontend.image_source frames and klt-vio throw an evio::Error saying so
-///    (eklt-vio runs without frames with frontend.image_source reconstructed);
+///    (eklt-vio and haste-vio run without frames with frontend.image_source
+///    reconstructed);
 ///  - calibration that does not match the data (frame size or the sensor size
 ///    stored in events.h5 differing from sensors.yaml / calib.txt, events
 ///    outside the sensor): evio::Error naming both sizes;

@@ -13,6 +13,8 @@
 ///    every n_e events, backend update per measurement set;
 ///  - `klt-vio`: KLT on the frames, one backend update per frame
 ///    (synchroniser trigger `track_time`);
+///  - `haste-vio`: HASTE on the events, seeded at corners of the frames (or
+///    of frames reconstructed from events), synchronised like eklt-vio;
 ///  - `tracks`: no frontend; feature tracks read from a file (e.g. the
 ///    simulator's truth/tracks.txt) with optional Gaussian pixel noise, to test
 ///    the backend in isolation.
@@ -141,7 +143,7 @@ struct PipelineOutputOptions {
 };
 
 struct PipelineOptions {
-  std::string method = "eklt-vio";   ///< eklt-vio | klt-vio | tracks
+  std::string method = "eklt-vio";   ///< eklt-vio | klt-vio | haste-vio | tracks
   std::uint64_t seed = 1;            ///< seed of the run's random streams (track noise)
   FrontendOptions frontend;
   SynchronizerOptions sync;
@@ -154,7 +156,7 @@ struct PipelineOptions {
 
   template <class V>
   void fields(V& v) {
-    v("method", method, "eklt-vio, klt-vio or tracks");
+    v("method", method, "eklt-vio, klt-vio, haste-vio or tracks");
     v("seed", seed, "seed of the run's random streams");
     v("frontend", frontend, "feature tracking frontend");
     v("sync", sync, "track synchroniser");

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Installs evio into a scratch prefix, and unpacks its Debian package, and
+# runs each from an unrelated folder: the binary must find its presets,
+# scenarios, estimator configurations and plot scripts relative to itself,
+# and nothing of the source tree may be compiled into it.
+#   install_test.sh <build folder> <source folder>
+set -euo pipefail
+build=$(realpath "$1")
+source=$(realpath "$2")
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# The Python package installed under the prefix $1 runs the binary beside it, and reads a sequence.
+check_python() {
+  local prefix=$1 found
+  found=$(cd "$scratch" && PYTHONPATH=$prefix/lib/python3/dist-packages /usr/bin/python3 -c 'import evio; print(evio.binary())') \
+    || fail "import evio from $prefix"
+  [[ $(realpath "$found") == $(realpath "$prefix/bin/evio") ]] || fail "the package under $prefix runs $found"
+}
+
+# Runs the installed binary $1 in an empty folder on a short simulated sequence.
+exercise() {
+  local evio=$1 work
+  work=$(mktemp -d "$scratch/work.XXXX")
+  cd "$work"
+  "$evio" --version >/dev/null || fail "$evio --version"
+  # A scenario named by its data-folder path; it pulls scene, trajectory and sensor presets.
+  "$evio" simulate experiments/scenarios/poster_6dof.yaml --set duration_s=1 output.write_events_txt=false -o seq -q \
+    || fail "simulate from $evio"
+  "$evio" info seq >/dev/null || fail "info"
+  # An estimator configuration named by its data-folder path.
+  "$evio" estimate seq --method klt-vio --config estimator/config/sim.yaml --init groundtruth -o est -q \
+    || fail "estimate with estimator/config/sim.yaml"
+  grep -qx 'status: ok' est/status.yaml || fail "estimate did not end ok: $(cat est/status.yaml)"
+  # A plot script from the data folder (only where matplotlib is installed).
+  if /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
+    "$evio" stats seq --plot stats.png -q >/dev/null || fail "stats --plot"
+    [[ -s stats.png ]] || fail "stats --plot wrote no PNG"
+  fi
+  cd "$scratch"
+}
+
+# 1. cmake --install into a prefix.
+cmake --install "$build" --prefix "$scratch/prefix" >/dev/null
+evio=$scratch/prefix/bin/evio
+[[ -x $evio ]] || fail "no installed binary at $evio"
+[[ -f $scratch/prefix/share/evio/experiments/campaigns/main.yaml ]] || fail "campaigns not installed"
+if strings "$evio" | grep -qF "$source"; then fail "the installed binary contains the source path $source"; fi
+exercise "$evio"
+check_python "$scratch/prefix"
+
+# 2. Without its data folder the binary says which folder is missing (exit 1).
+mv "$scratch/prefix/share/evio" "$scratch/moved"
+set +e
+msg=$(cd "$scratch" && "$evio" simulate experiments/scenarios/poster_6dof.yaml -o x -q 2>&1); code=$?
+set -e
+[[ $code -eq 1 ]] || fail "missing data folder: exit $code, expected 1"
+grep -qF "$scratch/prefix/share/evio" <<<"$msg" || fail "missing data folder not named: $msg"
+# ... and EVIO_DATA_DIR points it at a moved one.
+EVIO_DATA_DIR=$scratch/moved exercise "$evio"
+
+# 3. The Debian package, unpacked (no root needed): /usr/bin/evio with /usr/share/evio.
+cpack --config "$build/CPackConfig.cmake" -B "$scratch/pkg" >/dev/null || fail "cpack"
+deb=$(ls "$scratch"/pkg/*.deb)
+dpkg-deb -f "$deb" Depends | grep -q libembree || fail "package depends on no libembree: $(dpkg-deb -f "$deb" Depends)"
+dpkg-deb -x "$deb" "$scratch/root"
+exercise "$scratch/root/usr/bin/evio"
+check_python "$scratch/root/usr"
+echo "install test passed: prefix, moved data folder, Debian package ($(basename "$deb"))"

@@ -43,6 +43,7 @@ const std::vector<Bound>& bounds() {
       {"frontend.eklt.max_iterations", "1000", "1000000000"},
       {"frontend.eklt.bootstrap_window_px", "255", "100000"},
       {"frontend.eklt.bootstrap_pyramid_levels", "16", "1000"},
+      {"frontend.haste.harris_block_size", "101", "1000000"},
       {"frontend.klt.max_features", "10000", "100000000"},
       {"frontend.klt.window_px", "255", "100000"},
       {"frontend.klt.pyramid_levels", "16", "1000"},

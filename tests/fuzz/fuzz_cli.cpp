@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "commands.h"
+#include "commands.h"  // experiments/apps (evio_cli)
 #include "evio/core/error.h"
 
 namespace {

@@ -225,11 +225,13 @@ void installInterruptHandlers() {
   ::sigaction(SIGINT, &sa, nullptr);
   ::sigaction(SIGTERM, &sa, nullptr);
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit fails the write (EFBIG) instead of killing
+#if !defined(__SANITIZE_ADDRESS__)  // under ASan (debug preset) its own report is worth more
   struct sigaction crash {};
   crash.sa_handler = onLibraryCrash;
   sigemptyset(&crash.sa_mask);
   crash.sa_flags = SA_NODEFER;  // SIG_DFL is re-armed inside, and the fault repeats on return
   for (const int sig : {SIGFPE, SIGSEGV, SIGBUS}) ::sigaction(sig, &crash, nullptr);
+#endif
 }
 
 LibraryCrashGuard::LibraryCrashGuard(const char* library, const std::string& file)

@@ -13,7 +13,8 @@
 /// registered with InterruptCleanup (core/io/staged_folder.h), and exit
 /// code 1. The handlers are installed by installInterruptHandlers(); outside
 /// a guard these signals keep their default action (a crash of evio itself
-/// stays a crash, with its core dump).
+/// stays a crash, with its core dump). AddressSanitizer builds keep ASan's
+/// own handlers (its report names the fault) and do not install these.
 
 #include <string>
 

@@ -24,6 +24,7 @@ void ImuSensor::validate() const {
   requireNonNegative("imu.gyroscope_noise_density", gyroscope_noise_density);
   requireNonNegative("imu.gyroscope_random_walk", gyroscope_random_walk);
   requirePositive("imu.update_rate", update_rate);
+  requireInRange("imu.update_rate", update_rate, 0.0, 1e5);
 }
 
 void RangeFinderSensor::validate() const {

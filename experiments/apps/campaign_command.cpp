@@ -80,7 +80,7 @@ void addCampaignCommand(CLI::App& app) {
   cmd->add_option("campaign", args->campaign, "campaign YAML (experiments/campaigns/*.yaml)");
   cmd->add_option("-o,--output", args->results, "results folder");
   cmd->add_option("--set", args->overrides, "override a campaign key: seeds=[1,2], slurm.jobs_per_task=4");
-  cmd->add_option("-j,--jobs", args->workers, "jobs run in parallel")->check(CLI::PositiveNumber);
+  cmd->add_option("-j,--jobs", args->workers, "jobs run in parallel (1..1024)")->check(CLI::Range(1, 1024));
   cmd->add_flag("--retry-failed", args->retry_failed, "re-run jobs that finished with status failed");
   cmd->add_option("--slurm", args->slurm_script,
                   "write a Slurm job-array script (and <results>/slurm/tasks.txt) instead of running");

@@ -1,8 +1,10 @@
 #include "plot_runner.h"
 
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 
@@ -27,9 +29,14 @@ std::string runPlotScript(const std::string& script, const std::vector<std::stri
   argv.push_back(const_cast<char*>(path.c_str()));
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) return "plot failed: cannot fork";
   if (pid == 0) {
+    // The plot dies with evio (SIGINT/SIGTERM end evio at once): no orphan
+    // keeps writing after an interrupted command.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
     ::execv(python, argv.data());
     ::_exit(127);
   }

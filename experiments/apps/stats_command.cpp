@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/config.h"
+#include "evio/core/io/staged_folder.h"
 #include "evio/experiments/sequence_stats.h"
 #include "plot_runner.h"
 #include "progress_line.h"
@@ -49,9 +50,12 @@ void addStatsCommand(CLI::App& app) {
     if (!args->plot.empty()) {
       // The plot script reads the JSON: the -o file, else a temporary one.
       std::string input = args->output;
+      io::InterruptCleanup remove_on_signal;  // the temporary JSON, also on SIGINT/SIGTERM
       if (input.empty()) {
         input = (std::filesystem::temp_directory_path() / ("evio_stats_" + std::to_string(::getpid()) + ".json")).string();
+        remove_on_signal = io::InterruptCleanup(input);
         io::writeFileAtomic(input, json);
+        remove_on_signal.confirmCreated();
       }
       const std::string problem = runPlotScript("stats.py", {input, args->plot});
       if (args->output.empty()) std::filesystem::remove(input);

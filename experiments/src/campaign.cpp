@@ -266,9 +266,10 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
         for (std::size_t i = 0; i < v.size(); ++i)
           sl.extra.push_back(scalarAs<std::string>(doc, v[i], "slurm.extra[" + std::to_string(i) + "]"));
       }
-      if (sl.cpus_per_task < 1) throwAt(doc, s, "slurm.cpus_per_task", "must be >= 1");
-      if (sl.jobs_per_task < 1) throwAt(doc, s, "slurm.jobs_per_task", "must be >= 1");
-      if (sl.max_parallel < 0) throwAt(doc, s, "slurm.max_parallel", "must be >= 0");
+      if (sl.cpus_per_task < 1 || sl.cpus_per_task > 1024) throwAt(doc, s, "slurm.cpus_per_task", "must be in [1, 1024]");
+      if (sl.jobs_per_task < 1 || sl.jobs_per_task > 100000)
+        throwAt(doc, s, "slurm.jobs_per_task", "must be in [1, 100000]");
+      if (sl.max_parallel < 0 || sl.max_parallel > 100000) throwAt(doc, s, "slurm.max_parallel", "must be in [0, 100000]");
     }
   } catch (const YAML::Exception& e) {
     throw Error::inFile(doc.file, e.mark.line + 1, "invalid campaign: " + e.msg);

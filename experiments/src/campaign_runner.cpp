@@ -89,6 +89,18 @@ bool publish(const fs::path& from, const fs::path& to) {
   throw Error("cannot rename " + from.string() + " to " + to.string() + ": " + ec.message());
 }
 
+/// publish() while the SIGINT/SIGTERM handler keeps off `from` (it would
+/// otherwise empty a folder that is being renamed into place).
+bool publishClaimed(io::InterruptCleanup& cleanup, const fs::path& from, const fs::path& to) {
+  cleanup.beginPublish();
+  try {
+    return publish(from, to);
+  } catch (...) {
+    cleanup.cancelPublish();
+    throw;
+  }
+}
+
 std::string seconds(double s) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.3f", s);
@@ -156,7 +168,10 @@ std::string ensureSequence(const Campaign& c, const Job& job, const RunnerOption
   const fs::path tmp = final_dir.string() + ".tmp." + hostName() + "." + ctx.unique();
   fs::create_directories(final_dir.parent_path());
   fs::remove_all(tmp);
-  const io::InterruptCleanup cleanup(tmp.string());  // removed on SIGINT/SIGTERM
+  // Removed on SIGINT/SIGTERM, with the staging folder of the `simulate`
+  // child writing it ("<tmp>.staging.<child pid>"): the child dies by
+  // PDEATHSIG without cleaning up.
+  io::InterruptCleanup cleanup(tmp.string(), io::InterruptCleanup::Scope::kWithChildStaging);
   auto vars = vars_in;
   vars["sequence"] = tmp.string();
   StepRecord rec{"simulate", expandCommand(c, c.simulate, vars, job), "", 0.0};
@@ -174,7 +189,7 @@ std::string ensureSequence(const Campaign& c, const Job& job, const RunnerOption
     ctx.failed_sequences[job.sequence_key] = cause;
     return cause;
   }
-  publish(tmp, final_dir);
+  publishClaimed(cleanup, tmp, final_dir);
   return "";
 }
 
@@ -223,6 +238,7 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
   fs::remove_all(staging);
   io::InterruptCleanup cleanup(staging.string());  // removed on SIGINT/SIGTERM
   fs::create_directories(staging / "logs");
+  cleanup.confirmCreated();
 
   std::map<std::string, std::string> vars;
   vars["evio"] = o.evio_binary;
@@ -295,10 +311,17 @@ JobOutcome runJobIn(const Campaign& c, const Job& job, const RunnerOptions& o, R
   io::writeFileAtomic((staging / "job.yaml").string(),
                       jobYaml(c, job, vars["sequence"], outcome, steps, started));
   fs::create_directories(final_dir.parent_path());
-  if (o.retry_failed && fs::exists(final_dir))
-    io::publishFolder(staging.string(), final_dir.string());  // the failed job replaced whole, never mixed
-  else
-    publish(staging, final_dir);
+  if (o.retry_failed && fs::exists(final_dir)) {
+    cleanup.beginPublish();
+    try {
+      io::publishFolder(staging.string(), final_dir.string());  // the failed job replaced whole, never mixed
+    } catch (...) {
+      cleanup.cancelPublish();
+      throw;
+    }
+  } else {
+    publishClaimed(cleanup, staging, final_dir);
+  }
   cleanup.release();
   return outcome;
 }
@@ -319,6 +342,21 @@ bool staleName(const std::string& name, const std::string& host) {
   const long pid = std::strtol(pid_text.c_str(), &end, 10);
   if (end == pid_text.c_str() || *end != '\0') return false;
   return !processAlive(pid);
+}
+
+/// The campaign's own name inside a child's leftover in the sequence cache:
+/// "<x>.tmp.<host>.<pid>.<n>.staging.<child pid>" (what a `simulate` child
+/// killed by PDEATHSIG leaves) gives "<x>.tmp.<host>.<pid>.<n>" when the child
+/// is dead; any other name is returned as it is. A live child's folder gives
+/// a name that staleName() rejects.
+std::string campaignPart(const std::string& name) {
+  const std::size_t at = name.rfind(".staging.");
+  if (at == std::string::npos) return name;
+  const std::string pid_text = name.substr(at + 9);
+  if (pid_text.empty() || pid_text.size() > 12 || pid_text.find_first_not_of("0123456789") != std::string::npos)
+    return name;
+  if (processAlive(std::strtol(pid_text.c_str(), nullptr, 10))) return "";
+  return name.substr(0, at);
 }
 
 }  // namespace
@@ -399,7 +437,7 @@ std::size_t removeStaleStaging(const Campaign& c, const std::string& results) {
       if (scenario.is_directory())
         for (const auto& e : fs::directory_iterator(scenario.path(), ec)) {
           const std::string name = e.path().filename().string();
-          if (name.find(".tmp.") != std::string::npos && staleName(name, host))
+          if (name.find(".tmp.") != std::string::npos && staleName(campaignPart(name), host))
             removed += fs::remove_all(e.path(), ec) > 0;
         }
   return removed;

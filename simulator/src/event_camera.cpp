@@ -154,7 +154,7 @@ void EventCamera::Options::validate() const {
   requireNonNegative("refractory_period_s", refractory_period_s);
   requireInRange("refractory_mismatch_sigma", refractory_mismatch_sigma, 0.0, 1.0);
   requirePositive("log_eps_w_m2_sr", log_eps_w_m2_sr);
-  requireNonNegative("cutoff_max_hz", cutoff_max_hz);
+  requireInRange("cutoff_max_hz", cutoff_max_hz, 0.0, 1e6);
   requirePositive("cutoff_min_hz", cutoff_min_hz);
   requireField(cutoff_max_hz == 0.0 || cutoff_min_hz <= cutoff_max_hz, "cutoff_min_hz",
                "must be <= cutoff_max_hz");
@@ -171,11 +171,13 @@ void EventCamera::Options::validate() const {
   requireInRange("shot_noise_reference_pa", shot_noise_reference_pa, 1e-6, 1e6);
   requireInRange("source_follower_hz", source_follower_hz, 0.0, 1e7);
   requireInRange("ba_filter_window_s", ba_filter_window_s, 0.0, 10.0);
-  requireNonNegative("leak_rate_hz", leak_rate_hz);
-  requireNonNegative("shot_noise_rate_hz", shot_noise_rate_hz);
+  // Noise rates are per pixel; real sensors stay below ~1 Hz. The bounds keep
+  // a typo from turning a short sequence into an endless event stream.
+  requireInRange("leak_rate_hz", leak_rate_hz, 0.0, 1e4);
+  requireInRange("shot_noise_rate_hz", shot_noise_rate_hz, 0.0, 1e4);
   requireInRange("shot_noise_bright_factor", shot_noise_bright_factor, 0.0, 1e3);
   requireInRange("hot_pixel_fraction", hot_pixel_fraction, 0.0, 1.0);
-  requireNonNegative("hot_pixel_rate_hz", hot_pixel_rate_hz);
+  requireInRange("hot_pixel_rate_hz", hot_pixel_rate_hz, 0.0, 1e4);
   requireInRange("threads", threads, 0, 1024);
 }
 

@@ -213,6 +213,16 @@ TEST(SensorsYaml, WrongTypesAndValuesNameFieldAndLine) {
   }
 }
 
+TEST(SensorsYaml, AbsurdImuRateIsRejected) {  // issue 19: every rate has an upper bound
+  expectBad("update_rate: 1000", "update_rate: 1e12", {"bad.yaml", "imu.update_rate", "100000"});
+  const std::string ok = [] {
+    std::string t = kMinimal;
+    t.replace(t.find("update_rate: 1000"), 17, "update_rate: 1e5");
+    return t;
+  }();
+  EXPECT_NO_THROW(io::parseSensorsYaml(ok, "ok.yaml"));
+}
+
 TEST(SensorsYaml, NegativeNoiseDensityIsRejected) {
   expectBad("gyroscope_noise_density: 0.00016", "gyroscope_noise_density: -0.00016",
             {"bad.yaml:16", "imu.gyroscope_noise_density", ">= 0"});

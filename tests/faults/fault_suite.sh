@@ -195,31 +195,90 @@ damage "imu.txt is a folder" bash -c 'rm dmg/imu.txt; mkdir dmg/imu.txt'
 damage "imu.txt line of 2 MiB" bash -c 'head -c 2097152 /dev/zero | tr "\0" "1" >> dmg/imu.txt'
 damage "groundtruth time overflows" bash -c 'sed -i "3s/^[^ ]*/9223372037.0/" dmg/groundtruth.txt'
 damage "sensors.yaml symlink loop" bash -c 'rm dmg/sensors.yaml; ln -s sensors.yaml dmg/sensors.yaml'
+# A crafted events.h5 (found by fuzz_events_h5) on which libhdf5 itself divides
+# by zero in H5Dopen2 (a chunk dimension of 0): one evio error, not SIGFPE.
+damage "events.h5 that crashes libhdf5" bash -c "rm -f dmg/events.txt; cp '$src/tests/faults/data/events_h5_chunk_dim_zero.h5' dmg/events.h5"
 
-# ---- campaign: the campaign process killed at seeded times, then resumed ----------------------
+# ---- campaign: the campaign process killed inside its children, then resumed ------------------
 campaign_file="$src/experiments/campaigns/smoke.yaml"
 campaign_set=(--set 'seeds=[1]')
 "$evio" campaign "$campaign_file" -o camp_ref -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1
 rc=$?
 [ "$rc" = 0 ] || [ "$rc" = 3 ] || fail "campaign reference: exit $rc"
+# The kill points: the campaign is killed while its k-th child of one kind
+# runs (a simulate, estimate or evaluate step, the kinds in turn; k drawn from
+# the seeded schedule), so every kill lands inside a child's work. Smoke with
+# one seed runs 2 simulate, 12 estimate and 12 evaluate children.
+declare -A kill_in
+child_kind() { # <pid>: simulate | estimate | evaluate | other; "" when it is gone
+  local argv=()
+  mapfile -d '' -t argv < "/proc/$1/cmdline" 2> /dev/null || return 0
+  [ "${#argv[@]}" -gt 0 ] || return 0
+  case "${argv[0]##*/} ${argv[1]:-}" in
+    "evio trajectory" | "evio simulate") echo simulate ;;
+    "evio_fake_estimator "* | "evio estimate") echo estimate ;;
+    "evio evaluate") echo evaluate ;;
+    *) echo other ;;
+  esac
+}
+alive() { # <pid>: running (not gone, not a zombie), read with builtins only
+  local st
+  read -r st < "/proc/$1/stat" 2> /dev/null || return 1
+  st=${st##*) }
+  [ "${st:0:1}" != Z ]
+}
+kinds=(simulate estimate evaluate)
+point=0
 for action in INT TERM KILL; do
   for _ in $(seq 1 "$per"); do
-    delay_ms=$((RANDOM % 1500 + 50))
+    want=${kinds[$((point % 3))]}
+    point=$((point + 1))
+    if [ "$want" = simulate ]; then k=$((RANDOM % 2 + 1)); else k=$((RANDOM % 6 + 1)); fi
     rm -rf camp
     "$evio" campaign "$campaign_file" -o camp -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1 &
     pid=$!
-    sleep "$(printf '0.%03d' "$delay_ms")"
-    kill -s "$action" "$pid" 2> /dev/null
-    wait "$pid"
+    declare -A kind_of_child=()
+    declare -A count=()
+    kind=none
+    # Busy polling with builtins only (children of every thread of the
+    # campaign, from /proc): a fake estimate lives for a few milliseconds.
+    while alive "$pid"; do
+      hit=""
+      live=()
+      for t in /proc/"$pid"/task/*/children; do
+        read -r -a tk < "$t" 2> /dev/null || true
+        live+=("${tk[@]}")
+      done
+      for c in "${live[@]}"; do
+        if [ -z "${kind_of_child[$c]:-}" ]; then
+          kc=$(child_kind "$c")
+          [ -n "$kc" ] && [ "$kc" != other ] || continue  # gone, or not yet exec'd
+          kind_of_child[$c]=$kc
+          count[$kc]=$((${count[$kc]:-0} + 1))
+        fi
+        [ "${kind_of_child[$c]}" = "$want" ] && [ "${count[$want]:-0}" -ge "$k" ] && hit=$c
+      done
+      if [ -n "$hit" ]; then
+        kind=$want
+        kill -s "$action" "$pid" 2> /dev/null
+        break
+      fi
+    done
+    unset kind_of_child count
+    wait "$pid" 2> /dev/null
     rc=$?
     injected[campaign]=$((${injected[campaign]:-0} + 1))
-    # Every published job is complete; SIGINT/SIGTERM left no staging.
+    kill_in[$kind]=$((${kill_in[$kind]:-0} + 1))
+    # Every published job is complete; SIGINT/SIGTERM left no staging, in the
+    # job staging area or in the sequence cache (a simulate child's folder).
     for j in camp/jobs/*/; do
       [ -d "$j" ] || continue
-      [ -f "$j/metrics.json" ] && [ -f "$j/job.yaml" ] || fail "campaign $action@${delay_ms}ms: incomplete $(basename "$j")"
+      [ -f "$j/metrics.json" ] && [ -f "$j/job.yaml" ] || fail "campaign $action@$want$k: incomplete $(basename "$j")"
     done
     if [ "$action" != KILL ] && [ "$rc" != 0 ] && [ "$rc" != 3 ]; then
-      [ -z "$(ls -A camp/staging 2> /dev/null)" ] || fail "campaign $action@${delay_ms}ms: staging left: $(ls camp/staging)"
+      [ -z "$(ls -A camp/staging 2> /dev/null)" ] || fail "campaign $action@$want$k: staging left: $(ls camp/staging)"
+      [ -z "$(leftovers camp/sequences/x)" ] ||
+        fail "campaign $action@$want$k: left in the sequence cache: $(leftovers camp/sequences/x | tr '\n' ' ')"
       [ "$rc" = $((128 + $(kill -l "$action"))) ] || fail "campaign $action: exit $rc"
     fi
     if [ "$rc" = 0 ] || [ "$rc" = 3 ]; then outcome_new[campaign]=$((${outcome_new[campaign]:-0} + 1))
@@ -227,15 +286,22 @@ for action in INT TERM KILL; do
     "$evio" campaign "$campaign_file" -o camp -j 2 -q "${campaign_set[@]}" > /dev/null 2>&1
     rc=$?
     { [ "$rc" = 0 ] || [ "$rc" = 3 ]; } || fail "campaign resume after $action: exit $rc"
-    cmp -s camp_ref/summary.csv camp/summary.csv || fail "campaign resume after $action@${delay_ms}ms: summary differs"
+    cmp -s camp_ref/summary.csv camp/summary.csv || fail "campaign resume after $action@$want$k: summary differs"
     [ -z "$(ls -A camp/staging)" ] || fail "campaign resume after $action: staging left"
+    [ -z "$(leftovers camp/sequences/x)" ] || fail "campaign resume after $action: left $(leftovers camp/sequences/x)"
   done
+done
+[ "${kill_in[none]:-0}" = 0 ] || fail "campaign: ${kill_in[none]} kills found no child running (the schedule missed)"
+for kd in simulate estimate evaluate; do
+  [ "$per" -lt 3 ] || [ "${kill_in[$kd]:-0}" -gt 0 ] || fail "campaign: no kill landed in a $kd child"
 done
 
 echo "fault suite (seed $seed): command: injected faults -> previous output / new output / nothing"
 for c in simulate estimate evaluate campaign read; do
   echo "  $c: ${injected[$c]:-0} -> ${outcome_prev[$c]:-0} / ${outcome_new[$c]:-0} / ${outcome_none[$c]:-0}"
 done
+echo "  campaign kills inside a child: simulate ${kill_in[simulate]:-0}, estimate ${kill_in[estimate]:-0}," \
+  "evaluate ${kill_in[evaluate]:-0}, other ${kill_in[other]:-0}, none ${kill_in[none]:-0}"
 if [ "$failures" -gt 0 ]; then
   echo "fault suite: $failures FAILURES" >&2
   exit 1

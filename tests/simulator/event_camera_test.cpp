@@ -275,5 +275,28 @@ TEST(EventCamera, OptionsAreValidated) {
   EXPECT_THROW(EventCamera(4, 4, o, 1), Error);
 }
 
+TEST(EventCamera, AbsurdRatesAreOneErrorNamingTheField) {  // issue 19: every rate bounded
+  struct Case {
+    const char* field;
+    double EventCamera::Options::*member;
+    double largest;
+  };
+  for (const Case& c : {Case{"leak_rate_hz", &EventCamera::Options::leak_rate_hz, 1e4},
+                        Case{"shot_noise_rate_hz", &EventCamera::Options::shot_noise_rate_hz, 1e4},
+                        Case{"hot_pixel_rate_hz", &EventCamera::Options::hot_pixel_rate_hz, 1e4},
+                        Case{"cutoff_max_hz", &EventCamera::Options::cutoff_max_hz, 1e6}}) {
+    EventCamera::Options o;
+    o.*c.member = c.largest;
+    EXPECT_NO_THROW(o.validate()) << c.field;
+    o.*c.member = 1e12;
+    try {
+      o.validate();
+      ADD_FAILURE() << c.field << " = 1e12 accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(c.field), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace evio::simulator

@@ -7,6 +7,7 @@
 
 #include "events_h5_hdf5.h"
 #include "evio/core/io/events_h5.h"
+#include "evio/core/io/library_crash_guard.h"
 
 namespace evio::io {
 
@@ -359,6 +360,7 @@ EventH5Reader::EventH5Reader(std::string path, int width, int height)
     : impl_(std::make_unique<Impl>()) {
   h5::QuietErrors quiet;
   impl_->path = std::move(path);
+  const LibraryCrashGuard guard("HDF5", impl_->path);  // libhdf5's own crashes on crafted files
   if (width < 0 || height < 0 || width > 65536 || height > 65536 || (width == 0) != (height == 0))
     throw Error::inFile(impl_->path, 0, "invalid sensor size " + std::to_string(width) + "x" +
                                             std::to_string(height));
@@ -387,6 +389,7 @@ const std::string& EventH5Reader::path() const { return impl_->path; }
 
 void EventH5Reader::read(std::uint64_t begin, std::uint64_t count, EventArray& out) {
   h5::QuietErrors quiet;
+  const LibraryCrashGuard guard("HDF5", impl_->path);
   if (begin > impl_->n || count > impl_->n - begin)
     throw Error::inFile(impl_->path, 0,
                         "read of events " + str(begin) + " + " + str(count) + " beyond the " +
@@ -396,6 +399,7 @@ void EventH5Reader::read(std::uint64_t begin, std::uint64_t count, EventArray& o
 
 void EventH5Reader::readWindow(TimeNs t0_ns, TimeNs t1_ns, EventArray& out) {
   h5::QuietErrors quiet;
+  const LibraryCrashGuard guard("HDF5", impl_->path);
   Impl& r = *impl_;
   // Event times are (t_offset + rel) * 1000 ns, so t0 <= t  <=>  rel >= ceil(t0 / 1000) - t_offset.
   const std::int64_t u0 = std::max<std::int64_t>(h5::ceilDiv1000(t0_ns) - r.t_offset_us, 0);
@@ -412,6 +416,7 @@ void EventH5Reader::readWindow(TimeNs t0_ns, TimeNs t1_ns, EventArray& out) {
 
 bool EventH5Reader::next(EventArray& out, std::size_t max_events) {
   h5::QuietErrors quiet;
+  const LibraryCrashGuard guard("HDF5", impl_->path);
   Impl& r = *impl_;
   if (max_events == 0) throw Error::inFile(r.path, 0, "next(): max_events must be > 0");
   if (r.cursor >= r.n) {

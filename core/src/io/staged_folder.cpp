@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "evio/core/error.h"
+#include "evio/core/io/library_crash_guard.h"
 
 namespace evio::io {
 
@@ -25,13 +26,29 @@ namespace {
 
 // ---- the registry of paths to remove on SIGINT/SIGTERM ----------------------
 // Fixed storage, lock-free atomics: the handler reads it without allocating.
+// A slot's path is read by the handler only after the handler claimed the
+// slot (kActive -> kHandler); a claimed slot is never freed, so no thread
+// can rewrite the path while the handler reads it. A thread publishing the
+// path claims it first (kActive -> kPublishing), so the handler never
+// empties a folder that is being renamed into place.
 constexpr int kSlots = 256;
 constexpr std::size_t kPathMax = 4096;
+enum SlotState : int { kFree = 0, kWriting = 1, kActive = 2, kHandler = 3, kPublishing = 4 };
 struct Slot {
-  std::atomic<int> state{0};  // 0 free, 1 being written, 2 active
+  std::atomic<int> state{kFree};
+  bool child_staging = false;  // also remove "<path>.staging.<pid>" of a child process
+  std::size_t name_at = 0;     // where the last path component starts
+  std::atomic<long> publisher{0};  // thread id of the publishing thread (kPublishing)
   char path[kPathMax];
 };
 Slot g_slots[kSlots];
+std::atomic<bool> g_interrupted{false};  // set first thing by the handler
+
+/// Blocks this thread until the interrupt handler (running on another
+/// thread) ends the process.
+[[noreturn]] void waitForExit() {
+  for (;;) ::pause();
+}
 
 bool isDotOrDotDot(const char* n) { return n[0] == '.' && (n[1] == '\0' || (n[1] == '.' && n[2] == '\0')); }
 
@@ -61,12 +78,92 @@ void removeTreeAt(int dirfd, const char* name, int depth) {
 
 void writeAll(const char* s) { (void)!::write(2, s, std::strlen(s)); }
 
+/// True when `name` is `base` + ".staging." + digits (a child's staging folder).
+bool isChildStaging(const char* name, const char* base, std::size_t base_len) {
+  for (std::size_t i = 0; i < base_len; ++i)
+    if (name[i] != base[i]) return false;
+  const char* marker = ".staging.";
+  std::size_t i = base_len;
+  for (std::size_t k = 0; marker[k] != '\0'; ++k, ++i)
+    if (name[i] != marker[k]) return false;
+  if (name[i] == '\0') return false;
+  for (; name[i] != '\0'; ++i)
+    if (name[i] < '0' || name[i] > '9') return false;
+  return true;
+}
+
+/// Removes the "<path>.staging.<pid>" folders beside `slot.path` (system calls only).
+void removeChildStaging(const Slot& slot) {
+  char dir[kPathMax];
+  const std::size_t n = slot.name_at;
+  if (n == 0) {
+    dir[0] = '.', dir[1] = '\0';
+  } else {
+    for (std::size_t i = 0; i < n; ++i) dir[i] = slot.path[i];
+    dir[n] = '\0';
+  }
+  const char* base = slot.path + slot.name_at;
+  const std::size_t base_len = std::strlen(base);
+  const int fd = ::open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  alignas(16) char buf[4096];
+  for (;;) {
+    const long got = ::syscall(SYS_getdents64, fd, buf, sizeof(buf));
+    if (got <= 0) break;
+    for (long off = 0; off < got;) {
+      const auto* d = reinterpret_cast<const struct dirent64*>(buf + off);
+      off += d->d_reclen;
+      if (isChildStaging(d->d_name, base, base_len)) removeTreeAt(fd, d->d_name, 0);
+    }
+  }
+  ::close(fd);
+}
+
+long threadId() { return ::syscall(SYS_gettid); }
+
+/// Removes every registered path this thread may remove (system calls only).
+void removeRegisteredPaths() {
+  const long self = threadId();
+  for (auto& slot : g_slots) {
+    int expected = kActive;
+    if (!slot.state.compare_exchange_strong(expected, kHandler)) {
+      // Being published by another thread: leave it (the next run removes a
+      // leftover). Published by this very thread, the rename is not running.
+      expected = kPublishing;
+      if (slot.publisher.load() != self || !slot.state.compare_exchange_strong(expected, kHandler)) continue;
+    }
+    removeTreeAt(AT_FDCWD, slot.path, 0);
+    if (slot.child_staging) removeChildStaging(slot);
+  }
+}
+
 extern "C" void onInterrupt(int sig) {
-  for (auto& slot : g_slots)
-    if (slot.state.load() == 2) removeTreeAt(AT_FDCWD, slot.path, 0);
+  g_interrupted.store(true);
+  removeRegisteredPaths();
   writeAll(sig == SIGINT ? "evio: interrupted (SIGINT); unfinished output removed\n"
                          : "evio: terminated (SIGTERM); unfinished output removed\n");
   ::_exit(128 + sig);
+}
+
+// The file a third-party library is reading on this thread (LibraryCrashGuard).
+thread_local const char* t_crash_library = nullptr;
+thread_local const char* t_crash_file = nullptr;
+
+extern "C" void onLibraryCrash(int sig) {
+  if (t_crash_file == nullptr) {  // not inside a guarded read: the default action
+    ::signal(sig, SIG_DFL);
+    return;  // the faulting instruction runs again and takes it
+  }
+  g_interrupted.store(true);
+  removeRegisteredPaths();
+  writeAll("evio: error: ");
+  writeAll(t_crash_file);
+  writeAll(": the ");
+  writeAll(t_crash_library);
+  writeAll(" library crashed reading this file (");
+  writeAll(sig == SIGFPE ? "SIGFPE" : sig == SIGBUS ? "SIGBUS" : "SIGSEGV");
+  writeAll("); corrupt or hostile file, nothing published\n");
+  ::_exit(1);
 }
 
 bool allDigits(const std::string& s) {
@@ -128,19 +225,65 @@ void installInterruptHandlers() {
   ::sigaction(SIGINT, &sa, nullptr);
   ::sigaction(SIGTERM, &sa, nullptr);
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit fails the write (EFBIG) instead of killing
+#if !defined(__SANITIZE_ADDRESS__)  // under ASan (debug preset) its own report is worth more
+  struct sigaction crash {};
+  crash.sa_handler = onLibraryCrash;
+  sigemptyset(&crash.sa_mask);
+  crash.sa_flags = SA_NODEFER;  // SIG_DFL is re-armed inside, and the fault repeats on return
+  for (const int sig : {SIGFPE, SIGSEGV, SIGBUS}) ::sigaction(sig, &crash, nullptr);
+#endif
 }
 
-InterruptCleanup::InterruptCleanup(const std::string& path) {
+LibraryCrashGuard::LibraryCrashGuard(const char* library, const std::string& file)
+    : previous_library_(t_crash_library), previous_file_(t_crash_file), file_(file) {
+  t_crash_library = library;
+  t_crash_file = file_.c_str();
+}
+
+LibraryCrashGuard::~LibraryCrashGuard() {
+  t_crash_file = previous_file_;
+  t_crash_library = previous_library_;
+}
+
+InterruptCleanup::InterruptCleanup(const std::string& path, Scope scope) {
   if (path.size() + 1 > kPathMax) return;
   for (int i = 0; i < kSlots; ++i) {
-    int expected = 0;
-    if (g_slots[i].state.compare_exchange_strong(expected, 1)) {
-      std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
-      g_slots[i].state.store(2);
+    int expected = kFree;
+    if (g_slots[i].state.compare_exchange_strong(expected, kWriting)) {
+      Slot& slot = g_slots[i];
+      std::memcpy(slot.path, path.c_str(), path.size() + 1);
+      const std::size_t slash = path.rfind('/');
+      slot.name_at = slash == std::string::npos ? 0 : slash + 1;
+      slot.child_staging = scope == Scope::kWithChildStaging;
+      slot.state.store(kActive);
       slot_ = i;
+      // The handler is already running on another thread and may have passed
+      // this slot: create nothing more, the process is about to end.
+      if (g_interrupted.load()) waitForExit();
       return;
     }
   }
+}
+
+void InterruptCleanup::confirmCreated() const {
+  if (slot_ < 0 || !g_interrupted.load()) return;
+  // The handler may have looked before the path existed: remove it here.
+  removeTreeAt(AT_FDCWD, g_slots[slot_].path, 0);
+  waitForExit();
+}
+
+void InterruptCleanup::beginPublish() {
+  if (slot_ < 0) return;
+  g_slots[slot_].publisher.store(threadId());
+  int expected = kActive;
+  if (g_slots[slot_].state.compare_exchange_strong(expected, kPublishing)) return;
+  if (expected == kHandler) waitForExit();  // being removed: never publish it
+}
+
+void InterruptCleanup::cancelPublish() {
+  if (slot_ < 0) return;
+  int expected = kPublishing;
+  g_slots[slot_].state.compare_exchange_strong(expected, kActive);
 }
 
 InterruptCleanup::~InterruptCleanup() { release(); }
@@ -157,7 +300,13 @@ InterruptCleanup& InterruptCleanup::operator=(InterruptCleanup&& other) noexcept
 }
 
 void InterruptCleanup::release() {
-  if (slot_ >= 0) g_slots[slot_].state.store(0);
+  if (slot_ < 0) return;
+  // Free the slot unless the handler claimed it (it then stays claimed until
+  // the process ends, so its path is never rewritten under the handler).
+  for (int from : {kActive, kPublishing}) {
+    int expected = from;
+    if (g_slots[slot_].state.compare_exchange_strong(expected, kFree)) break;
+  }
   slot_ = -1;
 }
 
@@ -318,6 +467,7 @@ StagedFolder::StagedFolder(std::string target) : target_(std::move(target)) {
   cleanup_ = InterruptCleanup(staging_);
   if (::mkdir(staging_.c_str(), 0777) != 0)
     throw Error(staging_ + ": cannot create the staging folder: " + errnoText(errno));
+  cleanup_.confirmCreated();
 }
 
 StagedFolder::~StagedFolder() {
@@ -328,7 +478,13 @@ StagedFolder::~StagedFolder() {
 
 void StagedFolder::publish() {
   if (published_) throw Error(target_ + ": published twice");
-  publishFolder(staging_, target_);
+  cleanup_.beginPublish();
+  try {
+    publishFolder(staging_, target_);
+  } catch (...) {
+    cleanup_.cancelPublish();
+    throw;
+  }
   published_ = true;
   cleanup_.release();
 }
@@ -345,6 +501,7 @@ StagedFiles::StagedFiles(std::string main_file) : main_(std::move(main_file)) {
   cleanup_ = InterruptCleanup(staging_);
   if (::mkdir(staging_.c_str(), 0777) != 0)
     throw Error(staging_ + ": cannot create the staging folder: " + errnoText(errno));
+  cleanup_.confirmCreated();
 }
 
 StagedFiles::~StagedFiles() {
@@ -365,6 +522,14 @@ void StagedFiles::drop(const std::string& final_path) { dropped_.push_back(final
 
 void StagedFiles::publish() {
   if (published_) throw Error(main_ + ": published twice");
+  cleanup_.beginPublish();
+  struct Cancel {  // a failed publication leaves the staging folder to the handler again
+    InterruptCleanup& c;
+    bool armed = true;
+    ~Cancel() {
+      if (armed) c.cancelPublish();
+    }
+  } cancel{cleanup_};
   faultPoint(main_);
   if (::unlink(main_.c_str()) != 0 && errno != ENOENT)
     throw Error(main_ + ": cannot replace the previous output: " + errnoText(errno));
@@ -382,6 +547,7 @@ void StagedFiles::publish() {
         throw Error(f + ": cannot publish the output (rename from " + from + "): " + errnoText(errno));
     }
   (void)has_main;
+  cancel.armed = false;
   published_ = true;
   cleanup_.release();
   std::error_code ec;

@@ -7,8 +7,10 @@
 namespace evio::estimator {
 
 void BackendOptions::validate() const {
-  requireField(window_size >= 2, "window_size", "must be >= 2");
-  requireField(max_slam_features >= 0, "max_slam_features", "must be >= 0");
+  // Upper bounds on sizes keep a typo from exhausting memory or time: the state
+  // grows by 6 per window pose and 3 per SLAM feature, its covariance quadratically.
+  requireField(window_size >= 2 && window_size <= 200, "window_size", "must be in [2, 200]");
+  requireField(max_slam_features >= 0 && max_slam_features <= 1000, "max_slam_features", "must be in [0, 1000]");
   requirePositive("sigma_img_px", sigma_img_px);
   requireNonNegative("sigma_img_normalized", sigma_img_normalized);
   requireNonNegative("accelerometer_noise_density", accelerometer_noise_density);
@@ -32,11 +34,12 @@ void BackendOptions::validate() const {
   requireNonNegative("min_parallax_px", min_parallax_px);
   requireField(msckf_gate_probability > 0.0 && msckf_gate_probability < 1.0, "msckf_gate_probability",
                "must be in (0, 1)");
-  requireField(triangulation_max_iterations >= 1, "triangulation_max_iterations", "must be >= 1");
+  requireField(triangulation_max_iterations >= 1 && triangulation_max_iterations <= 1000, "triangulation_max_iterations",
+               "must be in [1, 1000]");
   requirePositive("triangulation_tolerance", triangulation_tolerance);
   requirePositive("triangulation_min_depth_m", triangulation_min_depth_m);
-  requireField(iekf_iterations >= 1, "iekf_iterations", "must be >= 1");
-  requireNonNegative("max_delay_s", max_delay_s);
+  requireField(iekf_iterations >= 1 && iekf_iterations <= 100, "iekf_iterations", "must be in [1, 100]");
+  requireInRange("max_delay_s", max_delay_s, 0.0, 60.0);  // measurements wait this long in memory
   requireNonNegative("max_late_s", max_late_s);
   requirePositive("max_velocity_mps", max_velocity_mps);
   requireNonNegative("range_sigma_m", range_sigma_m);
@@ -45,6 +48,7 @@ void BackendOptions::validate() const {
   requireInRange("range_max_feature_angle_deg", range_max_feature_angle_deg, 0.0, 90.0);
   requirePositive("zero_velocity_sigma_mps", zero_velocity_sigma_mps);
   requirePositive("static_window_s", static_window_s);
+  requireInRange("static_window_s", static_window_s, 0.0, 3600.0);  // the IMU window is buffered
   requirePositive("static_max_acc_std_mps2", static_max_acc_std_mps2);
   requirePositive("static_max_gyro_std_radps", static_max_gyro_std_radps);
 }

@@ -21,12 +21,12 @@ double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 }  // namespace
 
 void EkltOptions::validate() const {
-  requireField(max_features >= 1, "max_features", "must be >= 1");
+  requireField(max_features >= 1 && max_features <= 10000, "max_features", "must be in [1, 10000]");
   requireField(min_features >= 0 && min_features <= max_features, "min_features",
                "must be in [0, max_features]");
   requirePositive("harris_quality_level", harris_quality_level);
   requirePositive("harris_k", harris_k);
-  requireField(harris_block_size >= 1, "harris_block_size", "must be >= 1");
+  requireField(harris_block_size >= 1 && harris_block_size <= 101, "harris_block_size", "must be in [1, 101]");
   requireNonNegative("min_distance_px", min_distance_px);
   requireField(patch_size_px >= 3 && patch_size_px % 2 == 1 && patch_size_px <= 101, "patch_size_px",
                "must be odd and in [3, 101]");
@@ -34,8 +34,9 @@ void EkltOptions::validate() const {
   requirePositive("batch_contrast_threshold", batch_contrast_threshold);
   requireField(batch_min_events >= 1, "batch_min_events", "must be >= 1");
   requireField(batch_max_events >= batch_min_events, "batch_max_events", "must be >= batch_min_events");
+  requireField(batch_max_events <= 1000000, "batch_max_events", "must be <= 1000000");
   parseEkltSolverKind(solver);
-  requireField(max_iterations >= 1, "max_iterations", "must be >= 1");
+  requireField(max_iterations >= 1 && max_iterations <= 1000, "max_iterations", "must be in [1, 1000]");
   requireNonNegative("function_tolerance", function_tolerance);
   requireNonNegative("parameter_tolerance", parameter_tolerance);
   requireInRange("min_tracking_quality", min_tracking_quality, 0.0, 1.0);
@@ -43,8 +44,9 @@ void EkltOptions::validate() const {
   requireInRange("position_sigma_min_px", position_sigma_min_px, 1e-3, 100.0);
   requireField(position_sigma_max_px >= position_sigma_min_px && position_sigma_max_px <= 100.0,
                "position_sigma_max_px", "must be in [position_sigma_min_px, 100]");
-  requireField(bootstrap_window_px >= 3, "bootstrap_window_px", "must be >= 3");
-  requireField(bootstrap_pyramid_levels >= 1, "bootstrap_pyramid_levels", "must be >= 1");
+  requireField(bootstrap_window_px >= 3 && bootstrap_window_px <= 255, "bootstrap_window_px", "must be in [3, 255]");
+  requireField(bootstrap_pyramid_levels >= 1 && bootstrap_pyramid_levels <= 16, "bootstrap_pyramid_levels",
+               "must be in [1, 16]");
   requirePositive("log_offset", log_offset);
 }
 

@@ -33,7 +33,7 @@ void HasteOptions::validate() const {
   requireField(min_features >= 0 && min_features <= max_features, "min_features", "must be in [0, max_features]");
   requirePositive("harris_quality_level", harris_quality_level);
   requirePositive("harris_k", harris_k);
-  requireField(harris_block_size >= 1, "harris_block_size", "must be >= 1");
+  requireField(harris_block_size >= 1 && harris_block_size <= 101, "harris_block_size", "must be in [1, 101]");
   requireNonNegative("min_distance_px", min_distance_px);
   requireField(history_events >= 0 && history_events <= (1 << 24), "history_events", "must be in [0, 16777216]");
   requireInRange("seed_timeout_s", seed_timeout_s, 1e-6, 1e6);

@@ -13,7 +13,7 @@ void ImageReconstructorOptions::validate() const {
                "saturation_high", "need 0 <= saturation_low < saturation_high <= 255");
   requirePositive("log_offset", log_offset);
   requireField(output_every_events >= 0, "output_every_events", "must be >= 0");
-  requireNonNegative("output_rate_hz", output_rate_hz);
+  requireInRange("output_rate_hz", output_rate_hz, 0.0, 1e5);  // images per second
 }
 
 ImageReconstructor::ImageReconstructor(const ImageReconstructorOptions& options, int width, int height)

@@ -10,15 +10,15 @@
 namespace evio::estimator {
 
 void KltOptions::validate() const {
-  requireField(max_features >= 1, "max_features", "must be >= 1");
+  requireField(max_features >= 1 && max_features <= 10000, "max_features", "must be in [1, 10000]");
   requireField(min_features >= 0 && min_features <= max_features, "min_features",
                "must be in [0, max_features]");
   requireField(fast_threshold >= 1 && fast_threshold <= 255, "fast_threshold", "must be in [1, 255]");
   requireNonNegative("min_distance_px", min_distance_px);
-  requireField(border_px >= 0, "border_px", "must be >= 0");
-  requireField(window_px >= 3, "window_px", "must be >= 3");
-  requireField(pyramid_levels >= 1, "pyramid_levels", "must be >= 1");
-  requireField(max_iterations >= 1, "max_iterations", "must be >= 1");
+  requireField(border_px >= 0 && border_px <= 65536, "border_px", "must be in [0, 65536]");
+  requireField(window_px >= 3 && window_px <= 255, "window_px", "must be in [3, 255]");
+  requireField(pyramid_levels >= 1 && pyramid_levels <= 16, "pyramid_levels", "must be in [1, 16]");
+  requireField(max_iterations >= 1 && max_iterations <= 1000, "max_iterations", "must be in [1, 1000]");
   requirePositive("lk_epsilon", lk_epsilon);
   requirePositive("ransac_threshold_px", ransac_threshold_px);
   requireField(ransac_confidence > 0.0 && ransac_confidence < 1.0, "ransac_confidence", "must be in (0, 1)");

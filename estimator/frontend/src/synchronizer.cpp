@@ -12,7 +12,8 @@ void SynchronizerOptions::validate() const {
                "must be events, fixed_rate or track_time (got '" + trigger + "')");
   requireField(n_e >= 1, "n_e", "must be >= 1");
   requirePositive("rate_hz", rate_hz);
-  requireNonNegative("min_rate_hz", min_rate_hz);
+  requireInRange("rate_hz", rate_hz, 0.0, 1e5);  // updates per second
+  requireInRange("min_rate_hz", min_rate_hz, 0.0, 1e5);
   requireNonNegative("max_extrapolation_s", max_extrapolation_s);
   requireInRange("min_displacement_px", min_displacement_px, 0.0, 100.0);
   requireInRange("track_latency_s", track_latency_s, 0.0, 0.05);

@@ -9,7 +9,8 @@ namespace evio::estimator {
 
 void HealthOptions::validate() const {
   requirePositive("window_s", window_s);
-  requireField(min_window_dof >= 1, "min_window_dof", "must be >= 1");
+  requireInRange("window_s", window_s, 0.0, 3600.0);  // the window's updates are kept in memory
+  requireField(min_window_dof >= 1 && min_window_dof <= 1000000, "min_window_dof", "must be in [1, 1000000]");
   requireField(nis_probability > 0.0 && nis_probability < 1.0, "nis_probability", "must be in (0, 1)");
   requireField(nis_diverged_ratio > 1.0, "nis_diverged_ratio", "must be > 1 (E[ratio] = 1)");
   requirePositive("starvation_s", starvation_s);

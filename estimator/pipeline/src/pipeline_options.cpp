@@ -39,14 +39,16 @@ void CalibrationOptions::validate() const {
   requirePositive("gravity_mps2", gravity_mps2);
   requireInRange("time_offset_cam_imu_s", time_offset_cam_imu_s, -1.0, 1.0);
   requirePositive("imu_rate_hz", imu_rate_hz);
+  requireInRange("imu_rate_hz", imu_rate_hz, 0.0, 1e5);
   requireField(width >= 0 && height >= 0, "width", "width and height must be >= 0");
+  requireField(width <= 65536 && height <= 65536, "width", "width and height must be <= 65536");
   requireField((width == 0) == (height == 0), "width", "width and height must both be 0 or both > 0");
 }
 
 void TracksInputOptions::validate() const {
   requireField(!file.empty(), "file", "must not be empty");
   requireNonNegative("noise_px", noise_px);
-  requireNonNegative("rate_hz", rate_hz);
+  requireInRange("rate_hz", rate_hz, 0.0, 1e5);  // measurement sets per second
   requirePositive("max_gap_s", max_gap_s);
 }
 

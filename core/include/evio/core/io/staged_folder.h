@@ -31,15 +31,33 @@ void installInterruptHandlers();
 
 /// Registers `path` (a file or a folder) for removal on SIGINT/SIGTERM while
 /// the object lives. At most 256 registrations at once; more are not tracked.
+///
+/// Threads: the handler may run on any thread while others register, create,
+/// publish or release. Protocol: register, create the path, call
+/// confirmCreated(); before renaming the path into place call beginPublish()
+/// (the handler then leaves it alone), and release() after. A thread that
+/// finds the handler running blocks until the process ends.
 class InterruptCleanup {
  public:
+  enum class Scope {
+    kPath,              ///< the path only
+    kWithChildStaging,  ///< also "<path>.staging.<pid>" that a child process writes (e.g. `evio simulate -o <path>`)
+  };
   InterruptCleanup() = default;
-  explicit InterruptCleanup(const std::string& path);
+  explicit InterruptCleanup(const std::string& path, Scope scope = Scope::kPath);
   ~InterruptCleanup();
   InterruptCleanup(const InterruptCleanup&) = delete;
   InterruptCleanup& operator=(const InterruptCleanup&) = delete;
   InterruptCleanup(InterruptCleanup&& other) noexcept;
   InterruptCleanup& operator=(InterruptCleanup&& other) noexcept;
+  /// Call once the path exists: if the handler already ran on another
+  /// thread, removes the path and blocks until the process ends.
+  void confirmCreated() const;
+  /// The path is about to be renamed into place: the handler must not empty
+  /// it meanwhile. Blocks for good when the handler already claimed it.
+  void beginPublish();
+  /// The rename failed: the handler removes the path again on a signal.
+  void cancelPublish();
   /// Stops tracking (the path was published or removed).
   void release();
 

@@ -103,7 +103,11 @@ TEST(InterruptRace, PublishedOutputsStayWholeAndLeftoversAreStaleStaging) {
           << "run " << run << ": published " << name << " was emptied while being published";
     }
     runs_with_leftovers += leftover;
-    for (int w = 0; w < kWorkers; ++w) removeStaleStaging((dir / ("w" + std::to_string(w))).string());
+    for (int w = 0; w < kWorkers; ++w) {
+      std::string worker = "w";  // not "w" + to_string(w): GCC 12's -Wrestrict false positive
+      worker += std::to_string(w);
+      removeStaleStaging((dir / worker).string());
+    }
     for (const auto& e : fs::directory_iterator(dir))
       EXPECT_FALSE(isStagingName(e.path().filename().string())) << "run " << run << ": not removed: " << e.path();
   }

@@ -48,7 +48,14 @@ class PipelineSimulated : public ::testing::Test {
     dir_ = new test::TempDir();
     const simulator::Scenario scenario = simulator::loadScenario(
         std::string(EVIO_SOURCE_DIR) + "/experiments/scenarios/poster_6dof.yaml",
-        {"duration_s=2", "output.write_events_txt=false", "threads=0"}, EVIO_SOURCE_DIR);
+        {"duration_s=2", "output.write_events_txt=false", "threads=0",
+         // The legacy event pixel: this suite checks the pipelines end to end at
+         // the event density it was built for (an update per 3200 events, more
+         // than one per frame). The calibrated pixel gives a third of the events
+         // in these slow first seconds; what EKLT-VIO does with them is for the
+         // campaigns (README "Consistency").
+         "rig.event_camera.preset=simulator/presets/davis240c_legacy.yaml"},
+        EVIO_SOURCE_DIR);
     simulator::simulateSequence(scenario, sequence());
   }
   static void TearDownTestSuite() {
@@ -75,9 +82,7 @@ test::TempDir* PipelineSimulated::dir_ = nullptr;
 
 TEST_F(PipelineSimulated, EkltVio) {
   PipelineOptions o = fromGroundTruth("eklt-vio");
-  // An update every n_e = 3200 events: the calibrated DAVIS240C gives about
-  // 49 000 events in these slow first 2 s (README "Events calibrated").
-  runAndCheck(o, "eklt", 12);
+  runAndCheck(o, "eklt", 60);  // an update every 3200 events: more than one per frame
 }
 
 TEST_F(PipelineSimulated, KltVio) { runAndCheck(fromGroundTruth("klt-vio"), "klt", 40); }

@@ -3,25 +3,11 @@
 #include <string>
 
 #include "evio/core/error.h"
+#include "evio/core/options.h"
 #include "evio/estimator/frontend/eklt_tracker.h"
 #include "evio/estimator/frontend/haste_tracker.h"
 
 namespace evio::estimator {
-
-namespace {
-
-/// Runs a nested validate() and prefixes its message with the section name
-/// ("haste.margin: ...", so a message names the key as it is set).
-template <class Options>
-void validateSection(const char* section, const Options& options) {
-  try {
-    options.validate();
-  } catch (const Error& e) {
-    throw Error(std::string(section) + "." + e.what());
-  }
-}
-
-}  // namespace
 
 void FrontendOptions::validate() const {
   requireField(tracker == "eklt" || tracker == "klt" || tracker == "haste", "tracker",

@@ -4,22 +4,9 @@
 #include <string>
 
 #include "evio/core/error.h"
+#include "evio/core/options.h"
 
 namespace evio::estimator {
-
-namespace {
-
-/// Runs a nested validate() and prefixes its message with the section name.
-template <class Options>
-void validateSection(const char* section, const Options& options) {
-  try {
-    options.validate();
-  } catch (const Error& e) {
-    throw Error(std::string(section) + "." + e.what());
-  }
-}
-
-}  // namespace
 
 void InitOptions::validate() const {
   requireField(mode == "groundtruth" || mode == "static", "mode",

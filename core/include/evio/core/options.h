@@ -42,4 +42,16 @@ void requireInRange(std::string_view field, double value, double lo, double hi);
 /// Throws Error "<field>: <message>" unless condition holds.
 void requireField(bool condition, std::string_view field, std::string_view message);
 
+/// Runs a nested options struct's validate() and prefixes its error with
+/// the section's name, so the message names the key as it is set
+/// ("haste.margin: must be in …").
+template <class Options>
+void validateSection(std::string_view section, const Options& options) {
+  try {
+    options.validate();
+  } catch (const Error& e) {
+    throw Error(std::string(section) + "." + e.what());
+  }
+}
+
 }  // namespace evio

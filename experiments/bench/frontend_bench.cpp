@@ -31,43 +31,17 @@
 #include "evio/core/camera/camera.h"
 #include "evio/estimator/frontend/eklt_tracker.h"
 #include "evio/estimator/frontend/event_prefilter.h"
-#include "synthetic_events.h"
+#include "frontend_dataset.h"
 
 namespace {
 
 using evio::EventArray;
 using evio::TimeNs;
 
-constexpr int kWidth = 240;
-constexpr int kHeight = 180;
-constexpr double kDurationS = 1.0;
-constexpr double kFrameDtS = 0.05;
-constexpr double kContrast = 0.2;
-
-struct Dataset {
-  EventArray events;
-  std::vector<TimeNs> frame_t_ns;
-  std::vector<cv::Mat> frames;
-};
-
-const Dataset& dataset() {
-  static const Dataset data = [] {
-    Dataset d;
-    const auto tex = evio::test::BlobTexture::random(2022, kWidth, kHeight, 1800, 60.0);
-    evio::test::RigidMotion m;
-    m.velocity_px_s = evio::Vec2(50.0, -33.0);
-    m.omega_rad_s = 0.6;
-    m.centre = evio::Vec2(0.5 * (kWidth - 1), 0.5 * (kHeight - 1));
-    d.events = evio::test::generateEvents(tex, m, evio::test::Roi{0, 0, kWidth, kHeight}, 0.0, kDurationS, 1e-3,
-                                          kContrast);
-    for (double t = 0.0; t <= kDurationS + 1e-9; t += kFrameDtS) {
-      d.frame_t_ns.push_back(evio::secondsToNs(t));
-      d.frames.push_back(evio::test::render8(tex, m, t, kWidth, kHeight));
-    }
-    return d;
-  }();
-  return data;
-}
+using evio::bench::frontendDataset;
+using evio::bench::kHeight;
+using evio::bench::kWidth;
+using evio::bench::kContrast;
 
 double procStatusMb(const std::string& key) {
   std::ifstream in("/proc/self/status");
@@ -84,7 +58,7 @@ evio::Camera camera() {
 /// Runs EKLT over the whole data set; args: features, solver (0 lm, 1 ceres),
 /// refractory period in ms, random keep-one-in r.
 void BM_Eklt(benchmark::State& state) {
-  const Dataset& d = dataset();
+  const evio::bench::FrontendDataset& d = frontendDataset();
   std::ofstream("/proc/self/clear_refs") << "5";
   const double rss_start = procStatusMb("VmRSS");
   evio::estimator::EkltOptions options;

@@ -25,56 +25,25 @@
 
 #include "evio/core/camera/camera.h"
 #include "evio/estimator/frontend/haste_tracker.h"
-#include "synthetic_events.h"
+#include "frontend_dataset.h"
 
 namespace {
 
 using evio::EventArray;
 using evio::TimeNs;
 
-constexpr int kWidth = 240;
-constexpr int kHeight = 180;
-constexpr double kDurationS = 1.0;
-constexpr double kFrameDtS = 0.05;
-constexpr double kContrast = 0.2;
+using evio::bench::frontendDataset;
+using evio::bench::kHeight;
+using evio::bench::kWidth;
 
-struct Dataset {
-  EventArray events;
-  std::vector<TimeNs> frame_t_ns;
-  std::vector<cv::Mat> frames;
-};
-
-const Dataset& dataset() {
-  static const Dataset data = [] {
-    Dataset d;
-    const auto tex = evio::test::BlobTexture::random(2022, kWidth, kHeight, 1800, 60.0);
-    evio::test::RigidMotion m;
-    m.velocity_px_s = evio::Vec2(50.0, -33.0);
-    m.omega_rad_s = 0.6;
-    m.centre = evio::Vec2(0.5 * (kWidth - 1), 0.5 * (kHeight - 1));
-    d.events = evio::test::generateEvents(tex, m, evio::test::Roi{0, 0, kWidth, kHeight}, 0.0, kDurationS, 1e-3,
-                                          kContrast);
-    for (double t = 0.0; t <= kDurationS + 1e-9; t += kFrameDtS) {
-      d.frame_t_ns.push_back(evio::secondsToNs(t));
-      d.frames.push_back(evio::test::render8(tex, m, t, kWidth, kHeight));
-    }
-    return d;
-  }();
-  return data;
-}
-
-double threadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
+using evio::bench::threadCpuSeconds;
 
 const char* const kVariants[] = {"haste_correlation", "haste_correlation_star", "haste_difference",
                                  "haste_difference_star"};
 
 /// Runs HASTE over the whole data set; args: variant index (kVariants), features.
 void BM_Haste(benchmark::State& state) {
-  const Dataset& d = dataset();
+  const evio::bench::FrontendDataset& d = frontendDataset();
   evio::estimator::HasteOptions options;
   options.variant = kVariants[state.range(0)];
   options.max_features = static_cast<int>(state.range(1));

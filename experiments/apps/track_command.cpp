@@ -56,7 +56,7 @@ void addTrackCommand(CLI::App& app) {
     io::writeTracksText(staged.path(args->output), result.samples,
                         {"evio track " + args->folder + " (" + options.tracker + ", " + options.image_source + ")",
                          "pixels of camera " + result.camera_name, "id t x y"});
-    io::writeFileAtomic(staged.path(args->output + ".yaml"), config::toYaml(options));
+    io::writeFileAtomic(staged.path(args->output + ".yaml"), config::toYaml(result.options));
     staged.publish();
     if (!args->quiet)
       std::printf("%llu tracks, %zu samples; %llu events (%llu after filters), %llu frames; %.2f s in the frontend "

@@ -1,6 +1,7 @@
 #include "evio/experiments/track_sequence.h"
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <unordered_map>
@@ -77,6 +78,7 @@ struct CameraChoice {
   Camera camera;
   std::optional<Pose> T_B_C;
   std::string name;
+  std::map<std::string, double> event_parameters;  ///< the event camera's stated parameters (sensors.yaml)
 };
 
 CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
@@ -91,7 +93,9 @@ CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
         break;
       }
     if (pick == nullptr) pick = &rig.cameras.front();
-    return CameraChoice{pick->camera, pick->T_B_C, pick->name};
+    const CameraSensor* event = rig.firstCamera(CameraRole::kEvent);
+    return CameraChoice{pick->camera, pick->T_B_C, pick->name,
+                        event != nullptr ? event->parameters : std::map<std::string, double>{}};
   }
   const fs::path calib = fs::path(folder) / "calib.txt";
   if (!fs::exists(calib)) throw Error(folder + ": neither sensors.yaml nor calib.txt");
@@ -116,15 +120,16 @@ CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
 
 }  // namespace
 
-TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& options,
+TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& requested,
                                   const TrackProgress& progress) {
-  options.validate();
+  requested.validate();
   if (!fs::is_directory(folder)) throw Error(folder + ": not a folder");
   const bool has_images = fs::exists(fs::path(folder) / "images.txt");
   const std::vector<io::ImageStamp> images = has_images ? io::readImageList(folder) : std::vector<io::ImageStamp>{};
-  if (images.empty() && options.image_source == "frames")
+  if (images.empty() && requested.image_source == "frames")
     throw Error(folder + ": no frames (images.txt); use image_source reconstructed");
-  const CameraChoice cam = chooseCamera(folder, options.tracker == "klt", images);
+  const CameraChoice cam = chooseCamera(folder, requested.tracker == "klt", images);
+  const estimator::FrontendOptions options = estimator::resolveSensorParameters(requested, cam.event_parameters);
   ImuSamples imu;
   if (options.tracker == "eklt" && options.eklt.imu_prediction) {
     imu = io::readImuText((fs::path(folder) / "imu.txt").string());
@@ -142,6 +147,7 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   EventSource events(folder, /*required=*/options.tracker != "klt");
   TrackSequenceResult result;
   result.camera_name = cam.name;
+  result.options = options;
   std::unordered_map<std::int64_t, TimeNs> last_t;
   estimator::TrackPoints points;
   std::size_t next_imu = 0;

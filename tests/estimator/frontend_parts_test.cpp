@@ -74,6 +74,46 @@ TEST(ImageReconstructor, HighPassFilterStepsAndDecaysExactly) {
   EXPECT_EQ(img.at<float>(0, 0), 0.0f);
 }
 
+TEST(ImageReconstructor, StepsByThePolaritysOwnThreshold) {
+  ImageReconstructorOptions o;
+  o.cutoff_frequency_rad_s = 0.0;  // no decay: the state is the sum of the steps
+  o.contrast_threshold = 0.5;
+  o.contrast_threshold_neg = 0.38;
+  o.fuse_frames = false;
+  o.output_every_events = 0;
+  ImageReconstructor rec(o, 2, 1);
+  EventArray ev;
+  ev.push_back(secondsToNs(0.1), 0, 0, true);
+  ev.push_back(secondsToNs(0.2), 0, 0, true);
+  ev.push_back(secondsToNs(0.3), 1, 0, false);
+  rec.addEvents(ev, 0, ev.size());
+  const cv::Mat img = rec.image(secondsToNs(0.4));
+  EXPECT_NEAR(img.at<float>(0, 0), 1.0, 1e-6);
+  EXPECT_NEAR(img.at<float>(0, 1), -0.38, 1e-6);
+}
+
+// Zeros are filled from the event camera's stated thresholds, else the
+// DAVIS240C's; stated options are kept.
+TEST(FrontendOptions, SensorThresholdsFillTheUnsetOnes) {
+  const FrontendOptions unset;
+  const FrontendOptions from_rig =
+      resolveSensorParameters(unset, {{"contrast_threshold_pos", 0.3}, {"contrast_threshold_neg", 0.2}});
+  EXPECT_DOUBLE_EQ(from_rig.eklt.batch_contrast_threshold, 0.25);
+  EXPECT_DOUBLE_EQ(from_rig.reconstruction.contrast_threshold, 0.3);
+  EXPECT_DOUBLE_EQ(from_rig.reconstruction.contrast_threshold_neg, 0.2);
+  const FrontendOptions davis = resolveSensorParameters(unset, {{"pixel_pitch_um", 18.5}});
+  EXPECT_DOUBLE_EQ(davis.eklt.batch_contrast_threshold, 0.44);
+  EXPECT_DOUBLE_EQ(davis.reconstruction.contrast_threshold, 0.5);
+  EXPECT_DOUBLE_EQ(davis.reconstruction.contrast_threshold_neg, 0.38);
+  FrontendOptions stated;
+  stated.eklt.batch_contrast_threshold = 0.1;
+  stated.reconstruction.contrast_threshold = 0.2;
+  const FrontendOptions kept = resolveSensorParameters(stated, {{"contrast_threshold_pos", 0.3}, {"contrast_threshold_neg", 0.2}});
+  EXPECT_DOUBLE_EQ(kept.eklt.batch_contrast_threshold, 0.1);
+  EXPECT_DOUBLE_EQ(kept.reconstruction.contrast_threshold, 0.2);
+  EXPECT_DOUBLE_EQ(kept.reconstruction.contrast_threshold_neg, 0.0);  // 0: as contrast_threshold
+}
+
 TEST(ImageReconstructor, FusesUnsaturatedFramesAndKeepsEventsWhereSaturated) {
   ImageReconstructorOptions o;
   o.cutoff_frequency_rad_s = 5.0;

@@ -109,7 +109,9 @@ struct RigidMotion {
 };
 
 /// The log image at time t (CV_32FC1), L_t(x) = L(M_t⁻¹(x)) at pixel centres.
-inline cv::Mat renderLog(const BlobTexture& tex, const RigidMotion& m, double t, int width, int height) {
+/// `Motion` is RigidMotion or any type with the same inverse(x, t).
+template <class Motion>
+cv::Mat renderLog(const BlobTexture& tex, const Motion& m, double t, int width, int height) {
   cv::Mat out(height, width, CV_32FC1);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) out.at<float>(y, x) = static_cast<float>(tex(m.inverse(Vec2(x, y), t)));
@@ -135,8 +137,9 @@ struct Roi {
 /// Events of the pixels in `roi` between t0_s and t1_s, contrast threshold
 /// C, time step dt_s. Each pixel starts with its reference at L(t0); every
 /// crossing of ref ± C emits one event and moves the reference by ±C.
-inline EventArray generateEvents(const BlobTexture& tex, const RigidMotion& m, const Roi& roi, double t0_s,
-                                 double t1_s, double dt_s, double C) {
+template <class Motion>
+EventArray generateEvents(const BlobTexture& tex, const Motion& m, const Roi& roi, double t0_s, double t1_s,
+                          double dt_s, double C) {
   const int w = roi.x1 - roi.x0;
   const int h = roi.y1 - roi.y0;
   std::vector<double> ref(static_cast<std::size_t>(w * h));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include <opencv2/video/tracking.hpp>
 
@@ -31,7 +32,7 @@ void EkltOptions::validate() const {
   requireField(patch_size_px >= 3 && patch_size_px % 2 == 1 && patch_size_px <= 101, "patch_size_px",
                "must be odd and in [3, 101]");
   requirePositive("batch_displacement_px", batch_displacement_px);
-  requirePositive("batch_contrast_threshold", batch_contrast_threshold);
+  requireNonNegative("batch_contrast_threshold", batch_contrast_threshold);
   requireField(batch_min_events >= 1, "batch_min_events", "must be >= 1");
   requireField(batch_max_events >= batch_min_events, "batch_max_events", "must be >= batch_min_events");
   requireField(batch_max_events <= 1000000, "batch_max_events", "must be <= 1000000");
@@ -40,6 +41,8 @@ void EkltOptions::validate() const {
   requireNonNegative("function_tolerance", function_tolerance);
   requireNonNegative("parameter_tolerance", parameter_tolerance);
   requireInRange("min_tracking_quality", min_tracking_quality, 0.0, 1.0);
+  requireInRange("reversal_quality", reversal_quality, 0.0, 1.0);
+  requireInRange("max_batch_shift_px", max_batch_shift_px, 1e-3, 1000.0);
   requireNonNegative("lost_border_px", lost_border_px);
   requireInRange("position_sigma_min_px", position_sigma_min_px, 1e-3, 100.0);
   requireField(position_sigma_max_px >= position_sigma_min_px && position_sigma_max_px <= 100.0,
@@ -119,7 +122,9 @@ std::size_t EkltTracker::numAlive() const {
 }
 
 int EkltTracker::batchSize(double abs_sum) const {
-  const double n = options_.batch_displacement_px * abs_sum / options_.batch_contrast_threshold;
+  const double C = options_.batch_contrast_threshold > 0.0 ? options_.batch_contrast_threshold
+                                                           : kDavis240cContrastThreshold;
+  const double n = options_.batch_displacement_px * abs_sum / C;
   if (!std::isfinite(n)) return options_.batch_max_events;
   return static_cast<int>(std::clamp(std::lround(n), static_cast<long>(options_.batch_min_events),
                                      static_cast<long>(options_.batch_max_events)));
@@ -264,6 +269,37 @@ void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::si
   timing_.events_s += start.seconds();
 }
 
+std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBatch& batch, const Vec4& p0,
+                                                    const Vec2& predicted) {
+  // A solution is plausible when it moves the feature at most
+  // max_batch_shift_px from its prediction: the batch holds the events of
+  // about batch_displacement_px of motion (batchSize), so a longer jump is a
+  // wrong minimum of the cost, not the motion.
+  const auto shift = [&](const EkltSolution& sol) {
+    return sol.valid ? (ekltFeaturePosition(sol.p, s.centre, s.x0) - predicted).norm()
+                     : std::numeric_limits<double>::infinity();
+  };
+  const auto solve = [&](const Vec4& start) {
+    EkltSolution sol = solveEklt(solver_, batch, start, settings_);
+    ++timing_.optimisations;
+    timing_.solver_iterations += static_cast<std::uint64_t>(sol.iterations);
+    return sol;
+  };
+  EkltSolution sol = solve(p0);
+  const double max_shift = options_.max_batch_shift_px;
+  if (!sol.valid || sol.quality() < options_.reversal_quality || shift(sol) > max_shift) {
+    // The motion may have reversed: the increment −∇L·v changed sign, a
+    // minimum the optimiser cannot reach from the old φ. Start from φ + π.
+    ++timing_.reversal_solves;
+    const EkltSolution reversed = solve(Vec4(p0[0], p0[1], p0[2], p0[3] + M_PI));
+    const bool sol_ok = shift(sol) <= max_shift;
+    const bool reversed_ok = shift(reversed) <= max_shift;
+    if (reversed_ok && (!sol_ok || reversed.cost < sol.cost)) sol = reversed;
+  }
+  if (shift(sol) > max_shift) return std::nullopt;
+  return sol;
+}
+
 void EkltTracker::optimise(int index) {
   const Stopwatch start;
   Slot& s = slots_[static_cast<std::size_t>(index)];
@@ -289,10 +325,14 @@ void EkltTracker::optimise(int index) {
   const Vec2 d = predicted - s.centre;
   const Vec4 p0(s.theta, s.x0.x() - (c * d.x() - sn * d.y()), s.x0.y() - (sn * d.x() + c * d.y()), s.flow_angle);
   const EkltBatch batch{&s.templ, measured_.data(), options_.patch_size_px};
-  const EkltSolution sol = solveEklt(solver_, batch, p0, settings_);
-  ++timing_.optimisations;
-  timing_.solver_iterations += static_cast<std::uint64_t>(sol.iterations);
-
+  const std::optional<EkltSolution> solved = solveBatch(s, batch, p0, predicted);
+  if (!solved) {  // no solution the batch supports: drop its events, keep the feature where it was
+    ++timing_.batches_dropped;
+    resetPatch(s);
+    timing_.optimisation_s += start.seconds();
+    return;
+  }
+  const EkltSolution& sol = *solved;
   const Vec2 uv = ekltFeaturePosition(sol.p, s.centre, s.x0);
   if (!sol.valid || !uv.allFinite() || sol.quality() < options_.min_tracking_quality ||
       !camera_.isInside(uv, options_.lost_border_px)) {

@@ -21,6 +21,23 @@ void FrontendOptions::validate() const {
   validateSection("reconstruction", reconstruction);
 }
 
+FrontendOptions resolveSensorParameters(FrontendOptions options,
+                                        const std::map<std::string, double>& event_camera_parameters) {
+  const auto on = event_camera_parameters.find("contrast_threshold_pos");
+  const auto off = event_camera_parameters.find("contrast_threshold_neg");
+  const bool stated = on != event_camera_parameters.end() && off != event_camera_parameters.end() &&
+                      on->second > 0.0 && off->second > 0.0;
+  const double c_on = stated ? on->second : kDavis240cThresholdOn;
+  const double c_off = stated ? off->second : kDavis240cThresholdOff;
+  if (options.eklt.batch_contrast_threshold == 0.0) options.eklt.batch_contrast_threshold = 0.5 * (c_on + c_off);
+  ImageReconstructorOptions& r = options.reconstruction;
+  if (r.contrast_threshold == 0.0) {
+    r.contrast_threshold = c_on;
+    if (r.contrast_threshold_neg == 0.0) r.contrast_threshold_neg = c_off;
+  }
+  return options;
+}
+
 Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
     : options_(options) {
   options_.validate();

@@ -3,12 +3,14 @@
 #include <cmath>
 
 #include "evio/core/error.h"
+#include "evio/estimator/frontend/davis_thresholds.h"
 
 namespace evio::estimator {
 
 void ImageReconstructorOptions::validate() const {
   requireNonNegative("cutoff_frequency_rad_s", cutoff_frequency_rad_s);
-  requirePositive("contrast_threshold", contrast_threshold);
+  requireNonNegative("contrast_threshold", contrast_threshold);
+  requireNonNegative("contrast_threshold_neg", contrast_threshold_neg);
   requireField(saturation_low >= 0 && saturation_low < saturation_high && saturation_high <= 255,
                "saturation_high", "need 0 <= saturation_low < saturation_high <= 255");
   requirePositive("log_offset", log_offset);
@@ -32,14 +34,20 @@ std::size_t ImageReconstructor::addEvents(const EventArray& events, std::size_t 
   const auto& y = events.y();
   const auto& p = events.p();
   const double alpha = options_.cutoff_frequency_rad_s;
-  const float step = static_cast<float>(options_.contrast_threshold);
+  // Unresolved zeros (a caller that skipped resolveSensorParameters): the DAVIS240C's steps.
+  const double c_on = options_.contrast_threshold > 0.0 ? options_.contrast_threshold : kDavis240cThresholdOn;
+  const double c_off = options_.contrast_threshold_neg > 0.0 ? options_.contrast_threshold_neg
+                       : options_.contrast_threshold > 0.0 ? options_.contrast_threshold
+                                                           : kDavis240cThresholdOff;
+  const float step_on = static_cast<float>(c_on);
+  const float step_off = static_cast<float>(c_off);
   const TimeNs period_ns = options_.output_rate_hz > 0.0 ? secondsToNs(1.0 / options_.output_rate_hz) : 0;
   for (std::size_t i = begin; i < end; ++i) {
     require(x[i] < width_ && y[i] < height_, "ImageReconstructor: event outside the sensor");
     const std::size_t k = static_cast<std::size_t>(y[i]) * static_cast<std::size_t>(width_) + x[i];
     const double dt = nsToSeconds(t[i] - last_t_ns_[k]);
     const float decay = dt > 0.0 ? static_cast<float>(std::exp(-alpha * dt)) : 1.0f;
-    state_[k] = frame_log_[k] + (state_[k] - frame_log_[k]) * decay + (p[i] != 0 ? step : -step);
+    state_[k] = frame_log_[k] + (state_[k] - frame_log_[k]) * decay + (p[i] != 0 ? step_on : -step_off);
     last_t_ns_[k] = t[i];
     ++events_since_output_;
     bool due = options_.output_every_events > 0 &&

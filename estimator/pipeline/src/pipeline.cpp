@@ -66,7 +66,7 @@ class PipelineRun {
   }
 
   const std::string& sequence_;
-  const PipelineOptions& options_;
+  PipelineOptions options_;  // a copy: setup() fills in the sensor-dependent frontend options
   const std::string& output_;
   const PipelineProgressCallback& progress_;
   PipelineResult result_;
@@ -137,6 +137,7 @@ void PipelineRun::setup() {
   const CameraSensor& event_cam = rig_.eventCamera();
   tracker_camera_ = method.tracks_frame_camera ? &rig_.frameCamera() : &event_cam;
   result_.tracker_camera = tracker_camera_->name;
+  options_.frontend = resolveSensorParameters(options_.frontend, event_cam.parameters);  // config.yaml shows them
   if (method.tracks_frame_camera && tracker_camera_ == &event_cam && rig_.source == "sensors.yaml" &&
       rig_.rig.cameras.size() > 1)
     result_.notes.push_back(options_.method + ": no frame camera in sensors.yaml; using the event camera's calibration");

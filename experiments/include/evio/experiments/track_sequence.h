@@ -23,6 +23,7 @@ struct TrackSequenceResult {
   std::uint64_t tracks = 0;              ///< distinct track ids
   double processing_s = 0.0;             ///< wall time inside the frontend
   std::string camera_name;               ///< the camera whose pixels the tracks are in
+  estimator::FrontendOptions options;    ///< as run: the sensor's thresholds filled in (resolveSensorParameters)
 };
 
 /// Called with the share of events read (0..1) and the number read.

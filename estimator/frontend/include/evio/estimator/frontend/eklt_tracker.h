@@ -45,6 +45,8 @@ struct EkltTiming {
   std::uint64_t events_in_patches = 0;  ///< (event, feature) splats
   std::uint64_t optimisations = 0;
   std::uint64_t solver_iterations = 0;
+  std::uint64_t reversal_solves = 0;  ///< second solves from φ + π (EkltOptions::reversal_quality)
+  std::uint64_t batches_dropped = 0;  ///< batches without a plausible solution (max_batch_shift_px)
   /// Splatting and lookup: events_s − optimisation_s.
   double splattingS() const { return events_s - optimisation_s; }
 };
@@ -88,6 +90,10 @@ class EkltTracker final : public FeatureTracker {
   struct Slot;
   void splat(Slot& s, double x, double y, bool positive, TimeNs t_ns);
   void optimise(int slot_index);
+  /// The batch's solution from p0, re-solved from the reversed flow when
+  /// implausible (EkltOptions::reversal_quality, max_batch_shift_px);
+  /// nullopt when neither moves the feature plausibly.
+  std::optional<EkltSolution> solveBatch(const Slot& s, const EkltBatch& batch, const Vec4& p0, const Vec2& predicted);
   void activate(int slot_index, const Vec2& uv, TimeNs t_ns, double flow_angle);
   void lose(int slot_index);
   void free(int slot_index);

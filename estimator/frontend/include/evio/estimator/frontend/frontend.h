@@ -6,6 +6,7 @@
 /// event pre-filters (event_prefilter.h, options `prefilter`) run before it:
 /// the pipeline's PrefilterStage, or the caller.
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,6 +43,15 @@ struct FrontendOptions {
   }
   void validate() const;
 };
+
+/// The options with what the event camera's calibration states filled in:
+/// eklt.batch_contrast_threshold = 0 becomes the mean of the camera's
+/// `contrast_threshold_pos` and `contrast_threshold_neg` parameters
+/// (sensors.yaml), or kDavis240cContrastThreshold when it states neither.
+/// A stated option is kept. The pipeline and `evio track` call it, so the
+/// resolved value is what their config.yaml / tracks.txt.yaml record.
+FrontendOptions resolveSensorParameters(FrontendOptions options,
+                                        const std::map<std::string, double>& event_camera_parameters);
 
 class Frontend {
  public:

@@ -30,7 +30,12 @@ namespace evio::estimator {
 
 struct ImageReconstructorOptions {
   double cutoff_frequency_rad_s = 5.0;   ///< α, filter gain
-  double contrast_threshold = 0.25;      ///< C, log step per event
+  /// C, the log step per event; 0 (default): the sensor's own,
+  /// per polarity, as FrontendOptions resolves it (frontend.h):
+  /// contrast_threshold_pos / _neg of the camera's calibration, else the
+  /// DAVIS240C's 0.5 / 0.38.
+  double contrast_threshold = 0.0;
+  double contrast_threshold_neg = 0.0;   ///< C of OFF events; 0: as contrast_threshold
   bool fuse_frames = true;               ///< fuse unsaturated frame pixels (false: events only)
   int saturation_low = 5;                ///< frame pixels ≤ this are not fused
   int saturation_high = 250;             ///< frame pixels ≥ this are not fused
@@ -44,7 +49,8 @@ struct ImageReconstructorOptions {
   template <class V>
   void fields(V& v) {
     v("cutoff_frequency_rad_s", cutoff_frequency_rad_s, "filter gain alpha, rad/s");
-    v("contrast_threshold", contrast_threshold, "log step per event");
+    v("contrast_threshold", contrast_threshold, "log step per (ON) event (0: the sensor's)");
+    v("contrast_threshold_neg", contrast_threshold_neg, "log step per OFF event (0: as contrast_threshold)");
     v("fuse_frames", fuse_frames, "fuse unsaturated frame pixels");
     v("saturation_low", saturation_low, "frame pixels <= this are not fused");
     v("saturation_high", saturation_high, "frame pixels >= this are not fused");

@@ -471,6 +471,66 @@ void EventCamera::updatePixels(TimeNs t_ns, const std::uint32_t* indices, const 
   pixel_updates_ += count;
 }
 
+void EventCamera::updateRects(TimeNs t_ns, const std::vector<cv::Rect>& rects, const cv::Mat& radiance) {
+  require(radiance.type() == CV_32FC1 && radiance.rows == height_ && radiance.cols == width_ &&
+              radiance.isContinuous(),
+          "EventCamera::updateRects: radiance must be a continuous CV_32FC1 image of " + std::to_string(width_) +
+              "x" + std::to_string(height_));
+  const cv::Rect image(0, 0, width_, height_);
+  // Runs of one row, [begin, end) pixel indices, checked before any change.
+  runs_.clear();
+  std::size_t count = 0;
+  for (const cv::Rect& r : rects) {
+    if ((r & image) != r) throw Error("EventCamera::updateRects: a rectangle is not inside the image");
+    for (int y = r.y; y < r.y + r.height; ++y) {
+      const std::size_t begin = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                                static_cast<std::size_t>(r.x);
+      runs_.emplace_back(begin, begin + static_cast<std::size_t>(r.width));
+      for (std::size_t i = begin; i < begin + static_cast<std::size_t>(r.width); ++i) beginPerPixel(i, t_ns);
+      count += static_cast<std::size_t>(r.width);
+    }
+  }
+  // Blocks of whole runs of about kBlock / 4 pixels, fixed by the runs alone
+  // (not by the thread count); their events are concatenated in block order.
+  block_starts_.clear();
+  std::size_t in_block = 0;
+  for (std::size_t k = 0; k < runs_.size(); ++k) {
+    if (k == 0 || in_block >= kBlock / 4) {
+      block_starts_.push_back(k);
+      in_block = 0;
+    }
+    in_block += runs_[k].second - runs_[k].first;
+  }
+  block_starts_.push_back(runs_.size());
+  const std::size_t blocks = block_starts_.size() - 1;
+  if (block_events_.size() < blocks) block_events_.resize(blocks);
+  const float* in = radiance.ptr<float>();
+  const auto run = [&](std::size_t b) {
+    block_events_[b].clear();
+    for (std::size_t k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
+      const auto [begin, end] = runs_[k];
+      processBlock(begin, end, t_ns, in, &block_events_[b]);
+      std::fill(t_prev_.begin() + static_cast<std::ptrdiff_t>(begin), t_prev_.begin() + static_cast<std::ptrdiff_t>(end),
+                t_ns);
+    }
+  };
+  if (options_.threads == 1 || blocks <= 1) {
+    for (std::size_t b = 0; b < blocks; ++b) run(b);
+  } else {
+    tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t b = r.begin(); b != r.end(); ++b) run(b);
+                        });
+    });
+  }
+  for (std::size_t b = 0; b < blocks; ++b)
+    pending_.insert(pending_.end(), block_events_[b].begin(), block_events_[b].end());
+  if (count > 0) t_max_sample_ = std::max(t_max_sample_, t_ns);
+  pixel_updates_ += count;
+}
+
 inline void EventCamera::stepPixel(std::size_t i, TimeNs t_ns, float radiance) {
   const TimeNs t0 = t_prev_[i];
   const PixelMath pm(options_);

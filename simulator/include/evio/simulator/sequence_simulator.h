@@ -53,7 +53,8 @@ struct SimulationProgress {
   double simulated_s = 0.0;  ///< sequence time done, s
   double total_s = 0.0;      ///< sequence length, s
   std::uint64_t events = 0;
-  std::uint64_t renders = 0;
+  std::uint64_t renders = 0;         ///< whole-frame renders of the event camera
+  std::uint64_t tiles_rendered = 0;  ///< event-camera tiles traced, whole renders included
 };
 using ProgressCallback = std::function<void(const SimulationProgress&)>;
 
@@ -73,7 +74,11 @@ struct SimulationStats {
   double event_cpu_s = 0.0;          ///< CPU time (all threads) of EventCamera::update
   double truth_s = 0.0;              ///< ground truth, IMU, range, tracks passes
   int width = 0, height = 0;         ///< event sensor, px
-  std::uint64_t renders = 0;         ///< event-camera renders
+  std::string schedule;              ///< sampling.schedule: whole_frame or tiles
+  std::uint64_t renders = 0;         ///< whole-frame event-camera renders
+  std::uint64_t tile_steps = 0;      ///< steps that re-rendered only the tiles due ("tiles")
+  std::uint64_t tiles_rendered = 0;  ///< event-camera tiles traced (whole renders included)
+  std::uint64_t tile_count = 0;      ///< tiles per event-camera image
   std::uint64_t frame_renders = 0;   ///< separate frame-camera renders
   std::uint64_t pixel_updates = 0;   ///< event-camera pixel samples
   std::uint64_t events = 0;

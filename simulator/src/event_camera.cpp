@@ -490,6 +490,19 @@ void EventCamera::updateRects(TimeNs t_ns, const std::vector<cv::Rect>& rects, c
       count += static_cast<std::size_t>(r.width);
     }
   }
+  // Runs that touch (tiles side by side) become one: fewer, longer vector loops.
+  std::sort(runs_.begin(), runs_.end());
+  std::size_t merged = 0;
+  for (std::size_t k = 0; k < runs_.size(); ++k) {
+    if (merged > 0 && runs_[k].first < runs_[merged - 1].second)
+      throw Error("EventCamera::updateRects: the rectangles overlap");
+    if (merged > 0 && runs_[merged - 1].second == runs_[k].first) {
+      runs_[merged - 1].second = runs_[k].second;
+    } else {
+      runs_[merged++] = runs_[k];
+    }
+  }
+  runs_.resize(merged);
   // Blocks of whole runs of about kBlock / 4 pixels, fixed by the runs alone
   // (not by the thread count); their events are concatenated in block order.
   block_starts_.clear();

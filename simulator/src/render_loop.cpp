@@ -132,7 +132,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   if (tile_mode)
     tile_schedule.emplace(event_cam.width(), event_cam.height(), o.sampling.tile_px, samplerOptions(o.sampling),
                           std::min(eo.threshold_pos, eo.threshold_neg), eo.logEpsilon(), scenario.start_ns,
-                          o.sampling.tileQuantumNs());
+                          o.sampling.tileQuantumNs(), o.threads);
   stats->schedule = o.sampling.schedule;
   stats->tile_count = static_cast<std::uint64_t>(renderer.tileCount());
   std::optional<FrameCamera> frame_cam;

@@ -1,11 +1,16 @@
 #include "evio/simulator/tile_schedule.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "evio/core/error.h"
+#include "evio/core/options.h"
 
 namespace evio::simulator {
 
@@ -17,14 +22,16 @@ AdaptiveSampler::Options perPixel(AdaptiveSampler::Options o) {
 }  // namespace
 
 TileSchedule::TileSchedule(int width, int height, int tile_px, const AdaptiveSampler::Options& sampler,
-                           double threshold, double log_eps, TimeNs origin_ns, TimeNs quantum_ns)
+                           double threshold, double log_eps, TimeNs origin_ns, TimeNs quantum_ns, int threads)
     : width_(width),
       height_(height),
       tile_px_(tile_px),
       sampler_(perPixel(sampler), threshold, log_eps),
       log_eps_(static_cast<float>(log_eps)),
       origin_ns_(origin_ns),
-      quantum_ns_(quantum_ns) {
+      quantum_ns_(quantum_ns),
+      threads_(threads) {
+  requireInRange("threads", threads, 0, 1024);
   requirePositive("width", width);
   requirePositive("height", height);
   requireInRange("tile_px", tile_px, 1, 1024);
@@ -53,13 +60,57 @@ void TileSchedule::updateLog(int tile, const cv::Mat& radiance) {
   }
 }
 
-void TileSchedule::reschedule(int tile, TimeNs t_ns, const cv::Mat& flow) {
+float TileSchedule::tileRate(int tile, const cv::Mat& flow) const {
   const cv::Rect r = tileRect(tile);
-  const int x0 = r.x, y0 = r.y, x1 = r.x + r.width, y1 = r.y + r.height;
   float rate = 0.0f;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) rate = std::max(rate, sampler_.logRateAt(log_, flow, x, y));
-  due_[static_cast<std::size_t>(tile)] = onGrid(t_ns, sampler_.interval(rate));
+  if (!sampler_.options().rate_bound) {
+    for (int y = r.y; y < r.y + r.height; ++y)
+      for (int x = r.x; x < r.x + r.width; ++x) rate = std::max(rate, sampler_.logRateAt(log_, flow, x, y));
+    return rate;
+  }
+  // AdaptiveSampler::logRateAt with rate_bound, the same float operations in
+  // the same order, on row pointers: max over the 8 neighbours q of
+  // |L(q) − L(p)| / ‖q − p‖, times 1 / cos 22.5° · ‖u̇v‖; non-finite counts as 0.
+  for (int y = r.y; y < r.y + r.height; ++y) {
+    const float* rows[3] = {y > 0 ? log_.ptr<float>(y - 1) : nullptr, log_.ptr<float>(y),
+                            y + 1 < height_ ? log_.ptr<float>(y + 1) : nullptr};
+    const cv::Vec2f* f = flow.ptr<cv::Vec2f>(y);
+    for (int x = r.x; x < r.x + r.width; ++x) {
+      const float l = rows[1][x];
+      float slope = 0.0f;
+      for (int dy = -1; dy <= 1; ++dy) {
+        const float* row = rows[dy + 1];
+        if (row == nullptr) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx;
+          if ((dx == 0 && dy == 0) || qx < 0 || qx >= width_) continue;
+          const float d = std::abs(row[qx] - l) * (dx != 0 && dy != 0 ? 0.70710678f : 1.0f);
+          if (d > slope) slope = d;  // NaN never wins
+        }
+      }
+      const float v = slope * 1.0823922f * std::sqrt(f[x][0] * f[x][0] + f[x][1] * f[x][1]);
+      if (std::isfinite(v)) rate = std::max(rate, v);
+    }
+  }
+  return rate;
+}
+
+void TileSchedule::reschedule(int tile, TimeNs t_ns, const cv::Mat& flow) {
+  due_[static_cast<std::size_t>(tile)] = onGrid(t_ns, sampler_.interval(tileRate(tile, flow)));
+}
+
+template <class F>
+void TileSchedule::forTiles(std::size_t count, const F& f) const {
+  if (threads_ == 1) {
+    for (std::size_t k = 0; k < count; ++k) f(k);
+    return;
+  }
+  tbb::task_arena arena = threads_ > 0 ? tbb::task_arena(threads_) : tbb::task_arena();
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) f(k);
+    });
+  });
 }
 
 void TileSchedule::scheduleAll(TimeNs t_ns, const cv::Mat& radiance, const cv::Mat& flow) {
@@ -68,8 +119,9 @@ void TileSchedule::scheduleAll(TimeNs t_ns, const cv::Mat& radiance, const cv::M
   require(flow.type() == CV_32FC2 && flow.size() == radiance.size(),
           "TileSchedule: flow must be CV_32FC2 of the radiance's size");
   // All logs first: a tile's rate reads its neighbours' new samples.
-  for (int k = 0; k < tileCount(); ++k) updateLog(k, radiance);
-  for (int k = 0; k < tileCount(); ++k) reschedule(k, t_ns, flow);
+  const auto n = static_cast<std::size_t>(tileCount());
+  forTiles(n, [&](std::size_t k) { updateLog(static_cast<int>(k), radiance); });
+  forTiles(n, [&](std::size_t k) { reschedule(static_cast<int>(k), t_ns, flow); });
 }
 
 void TileSchedule::scheduleTiles(TimeNs t_ns, const std::vector<int>& tiles, const cv::Mat& radiance,
@@ -80,8 +132,9 @@ void TileSchedule::scheduleTiles(TimeNs t_ns, const std::vector<int>& tiles, con
           "TileSchedule: flow must be CV_32FC2 of the radiance's size");
   for (const int k : tiles)
     if (k < 0 || k >= tileCount()) throw Error("TileSchedule: tile " + std::to_string(k) + " out of range");
-  for (const int k : tiles) updateLog(k, radiance);
-  for (const int k : tiles) reschedule(k, t_ns, flow);
+  // All logs first: a tile's rate reads its neighbours' new samples.
+  forTiles(tiles.size(), [&](std::size_t i) { updateLog(tiles[i], radiance); });
+  forTiles(tiles.size(), [&](std::size_t i) { reschedule(tiles[i], t_ns, flow); });
 }
 
 TimeNs TileSchedule::nextTime() const { return *std::min_element(due_.begin(), due_.end()); }

@@ -33,8 +33,9 @@ class TileSchedule {
   /// column and row narrower), numbered row-major as Renderer's tiles of the
   /// same size. `sampler` gives λ, the rate bounds and the rate predictor
   /// (its tile_px is not used); `threshold` and `log_eps` as AdaptiveSampler.
+  /// `threads`: 0 = all cores, as the renderer (the schedule does not depend on it).
   TileSchedule(int width, int height, int tile_px, const AdaptiveSampler::Options& sampler, double threshold,
-               double log_eps, TimeNs origin_ns, TimeNs quantum_ns);
+               double log_eps, TimeNs origin_ns, TimeNs quantum_ns, int threads = 1);
 
   /// Every tile sampled at t_ns: radiance (CV_32FC1, W/(m²·sr)) and motion
   /// field (CV_32FC2, px/s) of the whole image; reschedules every tile.
@@ -60,11 +61,17 @@ class TileSchedule {
  private:
   void updateLog(int tile, const cv::Mat& radiance);
   void reschedule(int tile, TimeNs t_ns, const cv::Mat& flow);
+  /// The largest predicted log-rate Ṙ over the pixels of the tile (AdaptiveSampler::logRateAt, same bits).
+  float tileRate(int tile, const cv::Mat& flow) const;
+  /// f(k) for k in [0, count), in parallel (each call touches its own tile only).
+  template <class F>
+  void forTiles(std::size_t count, const F& f) const;
 
   int width_ = 0, height_ = 0, tile_px_ = 1, tiles_x_ = 0, tiles_y_ = 0;
   AdaptiveSampler sampler_;
   float log_eps_ = 0.0f;
   TimeNs origin_ns_ = 0, quantum_ns_ = 0;
+  int threads_ = 1;
   cv::Mat log_;               ///< L = log(ε + I) at each pixel's last sample (CV_32FC1)
   std::vector<TimeNs> due_;   ///< next sample time per tile
 };

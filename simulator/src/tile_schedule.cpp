@@ -71,26 +71,54 @@ float TileSchedule::tileRate(int tile, const cv::Mat& flow) const {
   // AdaptiveSampler::logRateAt with rate_bound, the same float operations in
   // the same order, on row pointers: max over the 8 neighbours q of
   // |L(q) − L(p)| / ‖q − p‖, times 1 / cos 22.5° · ‖u̇v‖; non-finite counts as 0.
-  for (int y = r.y; y < r.y + r.height; ++y) {
-    const float* rows[3] = {y > 0 ? log_.ptr<float>(y - 1) : nullptr, log_.ptr<float>(y),
-                            y + 1 < height_ ? log_.ptr<float>(y + 1) : nullptr};
+  // Pixels away from the image border: all 8 neighbours exist, no branches
+  // (the maximum does not depend on the order of its terms).
+  const int xa = std::max(r.x, 1), xb = std::min(r.x + r.width, width_ - 1);
+  const auto interior = [&](int y) {
+    const float* up = log_.ptr<float>(y - 1);
+    const float* mid = log_.ptr<float>(y);
+    const float* down = log_.ptr<float>(y + 1);
     const cv::Vec2f* f = flow.ptr<cv::Vec2f>(y);
-    for (int x = r.x; x < r.x + r.width; ++x) {
-      const float l = rows[1][x];
+    constexpr float kDiag = 0.70710678f;
+    for (int x = xa; x < xb; ++x) {
+      const float l = mid[x];
       float slope = 0.0f;
-      for (int dy = -1; dy <= 1; ++dy) {
-        const float* row = rows[dy + 1];
-        if (row == nullptr) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = x + dx;
-          if ((dx == 0 && dy == 0) || qx < 0 || qx >= width_) continue;
-          const float d = std::abs(row[qx] - l) * (dx != 0 && dy != 0 ? 0.70710678f : 1.0f);
-          if (d > slope) slope = d;  // NaN never wins
-        }
-      }
+      const auto take = [&slope](float d) { slope = d > slope ? d : slope; };  // NaN never wins
+      take(std::abs(up[x - 1] - l) * kDiag);
+      take(std::abs(up[x] - l) * 1.0f);
+      take(std::abs(up[x + 1] - l) * kDiag);
+      take(std::abs(mid[x - 1] - l) * 1.0f);
+      take(std::abs(mid[x + 1] - l) * 1.0f);
+      take(std::abs(down[x - 1] - l) * kDiag);
+      take(std::abs(down[x] - l) * 1.0f);
+      take(std::abs(down[x + 1] - l) * kDiag);
       const float v = slope * 1.0823922f * std::sqrt(f[x][0] * f[x][0] + f[x][1] * f[x][1]);
       if (std::isfinite(v)) rate = std::max(rate, v);
     }
+  };
+  // Pixels on the image border: the neighbours that exist.
+  const auto border = [&](int x, int y) {
+    const float l = log_.at<float>(y, x);
+    float slope = 0.0f;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int qx = x + dx, qy = y + dy;
+        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= width_ || qy >= height_) continue;
+        const float d = std::abs(log_.at<float>(qy, qx) - l) * (dx != 0 && dy != 0 ? 0.70710678f : 1.0f);
+        if (d > slope) slope = d;  // NaN never wins
+      }
+    const cv::Vec2f f = flow.at<cv::Vec2f>(y, x);
+    const float v = slope * 1.0823922f * std::sqrt(f[0] * f[0] + f[1] * f[1]);
+    if (std::isfinite(v)) rate = std::max(rate, v);
+  };
+  for (int y = r.y; y < r.y + r.height; ++y) {
+    if (y == 0 || y + 1 == height_) {
+      for (int x = r.x; x < r.x + r.width; ++x) border(x, y);
+      continue;
+    }
+    interior(y);
+    for (int x = r.x; x < xa; ++x) border(x, y);
+    for (int x = std::max(xb, r.x); x < r.x + r.width; ++x) border(x, y);
   }
   return rate;
 }

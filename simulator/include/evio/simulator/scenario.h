@@ -175,7 +175,7 @@ struct RenderScheduleOptions {
   double max_rate_hz = 1000.0;        ///< at most this often (cost bound), Hz (per tile with "tiles")
   bool rate_bound = true;             ///< predict with max neighbour slope · |flow| (else |∇L · flow|)
   double fastest_pixel_quantile = 1.0;///< q ∈ (0, 1]: 1 = the fastest pixel ("whole_frame" only)
-  int tile_px = 8;                    ///< render tile edge, px (the schedule's tiles with "tiles"); no effect on the output of "whole_frame"
+  int tile_px = 16;                   ///< render tile edge, px (the schedule's tiles with "tiles"); the renderer's default
   double tile_quantum_s = 0.0;        ///< "tiles": due times on a grid of this period, s; 0 = 1 / max_rate_hz
   int supersampling = 1;              ///< n × n radiance rays per pixel
 

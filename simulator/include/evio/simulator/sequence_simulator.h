@@ -22,12 +22,14 @@
 ///   simulation_stats.yaml counts and wall-clock times (the only file that
 ///                         differs between two runs)
 ///
-/// Render scheduling. The renderer traces whole images only (renderer.h has
-/// no call for a subset of pixels), so the event camera is sampled by whole
-/// frames at adaptive steps: after a render at t the next one is due after
-/// Δt = clamp(λ C / Ṙ_q, 1 / max_rate_hz, 1 / min_rate_hz) (scenario.h,
-/// RenderScheduleOptions), Ṙ_q from the rendered radiance and the analytic
-/// motion field. Renders are also placed at every frame sub-sample (a
+/// Render scheduling (scenario.h, RenderScheduleOptions::schedule).
+/// "whole_frame": the event camera is sampled by whole frames at adaptive
+/// steps: after a render at t the next one is due after
+/// Δt = clamp(λ C / Ṙ_q, 1 / max_rate_hz, 1 / min_rate_hz), Ṙ_q from the
+/// rendered radiance and the analytic motion field. "tiles": each tile has
+/// its own next-sample time (tile_schedule.h) and a step re-renders only the
+/// tiles due (Renderer::renderTiles), feeding their pixels to the event
+/// camera (EventCamera::updateRects). Whole renders are also placed at every frame sub-sample (a
 /// co-located frame camera shares the event camera's renders and feeds them
 /// to the event camera too), at every frame stamp (depth truth) and at the
 /// end of the window. A separate frame camera renders its own sub-samples.

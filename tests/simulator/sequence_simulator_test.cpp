@@ -111,6 +111,15 @@ TEST(SequenceSimulator, TileScheduleIsByteIdenticalWithOneAndTwoThreadsAndKeepsF
   EXPECT_EQ(a.tile_count, 8u * 6u);
   EXPECT_EQ(a.tiles_rendered, b.tiles_rendered);
   expectSameFiles(tmp, "a", "b");
+  // The stream written step by step up to each watermark is time-sorted,
+  // inside the window, one label per event.
+  const Scenario scenario = loadTestScenario();
+  const EventArray ev = io::readEventsText(tmp.file("a/events.txt"), io::SensorSize{64, 48});
+  ASSERT_EQ(ev.size(), a.events);
+  for (std::size_t i = 1; i < ev.size(); ++i) ASSERT_LE(ev.t()[i - 1], ev.t()[i]) << i;
+  EXPECT_GE(ev.t().front(), scenario.start_ns);
+  EXPECT_LE(ev.t().back(), scenario.end_ns);
+  EXPECT_EQ(io::readEventLabels(tmp.file("a/truth/event_labels.bin")).size(), a.events);
   // Frames and depth come from whole renders at the same times in either
   // schedule: the same bytes as the whole-frame schedule's.
   const auto w = simulateSequence(loadTestScenario({"threads=2"}), tmp.file("w"));

@@ -40,8 +40,9 @@ void addSimulateCommand(CLI::App& app) {
     const auto stats = simulator::simulateSequence(
         scenario, out.path(), [&line](const simulator::SimulationProgress& p) {
           char label[96];
-          std::snprintf(label, sizeof(label), "simulate %.2f/%.2f s sim, %llu renders", p.simulated_s, p.total_s,
-                        static_cast<unsigned long long>(p.renders));
+          std::snprintf(label, sizeof(label), "simulate %.2f/%.2f s sim, %llu renders, %llu tiles", p.simulated_s,
+                        p.total_s, static_cast<unsigned long long>(p.renders),
+                        static_cast<unsigned long long>(p.tiles_rendered));
           line.setLabel(label);
           line.update(p.total_s > 0 ? p.simulated_s / p.total_s : 1.0, static_cast<double>(p.events));
         });
@@ -50,10 +51,14 @@ void addSimulateCommand(CLI::App& app) {
     if (args->quiet) return;
     std::printf("simulated %.3f s in %.1f s wall (%.3f x real time; scene build %.1f s)\n", stats.simulated_s,
                 stats.wall_s, stats.realTimeFactor(), stats.scene_build_s);
-    std::printf("%llu renders (%.1f /s of render time), %llu pixel updates (%.0f M/s in the event camera), "
-                "%llu events (%.0f /s simulated), %llu frames\n",
-                static_cast<unsigned long long>(stats.renders),
-                stats.render_s > 0 ? static_cast<double>(stats.renders) / stats.render_s : 0.0,
+    const double equivalents =
+        stats.tile_count > 0 ? static_cast<double>(stats.tiles_rendered) / static_cast<double>(stats.tile_count) : 0.0;
+    std::printf("schedule %s: %llu whole renders, %llu tile steps, %llu tiles traced (%.1f renders' worth, %.1f /s "
+                "of render time)\n",
+                stats.schedule.c_str(), static_cast<unsigned long long>(stats.renders),
+                static_cast<unsigned long long>(stats.tile_steps), static_cast<unsigned long long>(stats.tiles_rendered),
+                equivalents, stats.render_s > 0 ? equivalents / stats.render_s : 0.0);
+    std::printf("%llu pixel updates (%.0f M/s in the event camera), %llu events (%.0f /s simulated), %llu frames\n",
                 static_cast<unsigned long long>(stats.pixel_updates),
                 stats.event_s > 0 ? static_cast<double>(stats.pixel_updates) / stats.event_s / 1e6 : 0.0,
                 static_cast<unsigned long long>(stats.events),

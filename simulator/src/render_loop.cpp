@@ -11,6 +11,7 @@
 #include "evio/simulator/event_camera.h"
 #include "evio/simulator/frame_camera.h"
 #include "evio/simulator/renderer.h"
+#include "evio/simulator/tile_schedule.h"
 
 namespace evio::simulator {
 
@@ -28,6 +29,15 @@ CameraVelocity cameraVelocity(const TrajectoryState& s, const Pose& T_B_C) {
   v.v_C = (R_W_B * R_B_C).transpose() * p_dot_W;
   v.omega_C = R_B_C.transpose() * s.omega_B;
   return v;
+}
+
+AdaptiveSampler::Options samplerOptions(const RenderScheduleOptions& o) {
+  AdaptiveSampler::Options s;
+  s.lambda = o.lambda;
+  s.min_rate_hz = o.min_rate_hz;
+  s.max_rate_hz = o.max_rate_hz;
+  s.rate_bound = o.rate_bound;
+  return s;
 }
 
 /// The next render interval: λ C over the q-quantile of the predicted
@@ -57,14 +67,6 @@ class StepPredictor {
   }
 
  private:
-  static AdaptiveSampler::Options samplerOptions(const RenderScheduleOptions& o) {
-    AdaptiveSampler::Options s;
-    s.lambda = o.lambda;
-    s.min_rate_hz = o.min_rate_hz;
-    s.max_rate_hz = o.max_rate_hz;
-    s.rate_bound = o.rate_bound;
-    return s;
-  }
   AdaptiveSampler sampler_;
   double quantile_;
   std::vector<float> rates_;
@@ -113,6 +115,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   RendererOptions ro;
   ro.threads = o.threads;
   ro.supersampling = o.sampling.supersampling;
+  ro.tile_px = o.sampling.tile_px;
   const Renderer renderer(scene, event_cam, ro);
   std::optional<Renderer> frame_renderer;
   const bool frames = fo.enabled;
@@ -124,6 +127,14 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   eo.threads = o.threads;
   EventCamera events_cam(event_cam.width(), event_cam.height(), eo, o.seed);
   StepPredictor predictor(o.sampling, eo);
+  const bool tile_mode = o.sampling.tiles();
+  std::optional<TileSchedule> tile_schedule;
+  if (tile_mode)
+    tile_schedule.emplace(event_cam.width(), event_cam.height(), o.sampling.tile_px, samplerOptions(o.sampling),
+                          std::min(eo.threshold_pos, eo.threshold_neg), eo.logEpsilon(), scenario.start_ns,
+                          o.sampling.tileQuantumNs(), o.threads);
+  stats->schedule = o.sampling.schedule;
+  stats->tile_count = static_cast<std::uint64_t>(renderer.tileCount());
   std::optional<FrameCamera> frame_cam;
   if (frames) {
     FrameCamera::Options fco = fo.sensor;
@@ -187,15 +198,80 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   RenderLoopResult result;
   EventArray batch;
   std::vector<EventLabel> labels;
-  TimeNs next_event = scenario.start_ns;
+  TimeNs next_event = scenario.start_ns;  // the next whole-frame step ("whole_frame")
   TimeNs last_t = kNever;
-  RenderOutput last;
+  RenderOutput last;                      // the latest sample of every pixel
+  std::vector<int> due_tiles;
+  std::vector<cv::Rect> due_rects;
+  const auto writeBatch = [&] {
+    const Stopwatch watch;
+    writer.appendEvents(batch, labels);
+    stats->write_s += watch.seconds();
+  };
+  // Every pixel sampled at t: a whole render, EventCamera::update (which
+  // emits every event up to t), and the next step predicted from it.
+  const auto wholeStep = [&](TimeNs t, const Pose& T_W_E, const CameraVelocity& velocity) {
+    Stopwatch watch;
+    double cpu0_s = Stopwatch::processCpuSeconds();
+    renderer.render(T_W_E, &velocity, &last);  // reuses last's images unless they are shared
+    stats->render_s += watch.seconds();
+    stats->render_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
+    ++stats->renders;
+    stats->tiles_rendered += stats->tile_count;
+
+    watch.restart();
+    cpu0_s = Stopwatch::processCpuSeconds();
+    batch.clear();
+    labels.clear();
+    events_cam.update(t, last.radiance, &batch, &labels);
+    stats->event_s += watch.seconds();
+    stats->event_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
+    writeBatch();
+
+    watch.restart();
+    if (tile_mode) {
+      tile_schedule->scheduleAll(t, last.radiance, last.flow);
+    } else if (t < scenario.end_ns) {  // the next step, predicted from this (latest) sample
+      next_event = t + predictor.interval(last.radiance, last.flow);
+    }
+    stats->schedule_s += watch.seconds();
+  };
+  // The tiles due at t only: renderTiles, their pixels to the event camera,
+  // the events up to the watermark (the earliest last sample of any pixel).
+  const auto tileStep = [&](TimeNs t, const Pose& T_W_E, const CameraVelocity& velocity) {
+    Stopwatch watch;
+    double cpu0_s = Stopwatch::processCpuSeconds();
+    tile_schedule->dueTiles(t, &due_tiles);
+    renderer.renderTiles(T_W_E, &velocity, due_tiles.data(), due_tiles.size(), &last);
+    stats->render_s += watch.seconds();
+    stats->render_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
+    ++stats->tile_steps;
+    stats->tiles_rendered += due_tiles.size();
+
+    watch.restart();
+    cpu0_s = Stopwatch::processCpuSeconds();
+    due_rects.clear();
+    for (const int k : due_tiles) due_rects.push_back(renderer.tileRect(k));
+    events_cam.updateRects(t, due_rects, last.radiance);
+    batch.clear();
+    labels.clear();
+    events_cam.emit(&batch, &labels);
+    stats->event_s += watch.seconds();
+    stats->event_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
+    writeBatch();
+
+    watch.restart();
+    tile_schedule->scheduleTiles(t, due_tiles, last.radiance, last.flow);
+    stats->schedule_s += watch.seconds();
+  };
+
   const double total_s = nsToSeconds(scenario.end_ns - scenario.start_ns);
   while (true) {
     if (!frames_done && !frame) beginFrame();
     const TimeNs t_frame = frame ? frame->next() : kNever;
     const TimeNs t_depth = frame && depth_on && !frame->depth_done ? frame->stamp_ns : kNever;
-    const TimeNs t = std::min({next_event, scenario.end_ns, t_depth, separate ? kNever : t_frame});
+    const TimeNs t_step = tile_mode && last_t != kNever ? tile_schedule->nextTime() : next_event;
+    const TimeNs t = std::min({t_step, scenario.end_ns, t_depth, separate ? kNever : t_frame});
 
     if (separate && t_frame <= t) {  // a separate frame camera's own sub-sample
       const Pose T_W_F = trajectory.evaluate(t_frame).T_W_B * T_B_F;
@@ -211,34 +287,19 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
       const TrajectoryState state = trajectory.evaluate(t);
       const Pose T_W_E = state.T_W_B * T_B_E;
       const CameraVelocity velocity = cameraVelocity(state, T_B_E);
-      Stopwatch watch;
-      double cpu0_s = Stopwatch::processCpuSeconds();
-      renderer.render(T_W_E, &velocity, &last);  // reuses last's images unless they are shared
-      stats->render_s += watch.seconds();
-      stats->render_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
-      ++stats->renders;
-
-      watch.restart();
-      cpu0_s = Stopwatch::processCpuSeconds();
-      batch.clear();
-      labels.clear();
-      events_cam.update(t, last.radiance, &batch, &labels);
-      stats->event_s += watch.seconds();
-      stats->event_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
-
-      watch.restart();
-      writer.appendEvents(batch, labels);
-      stats->write_s += watch.seconds();
+      // Frames, depth truth and the end need every pixel at t, exactly.
+      const bool whole = !tile_mode || last_t == kNever || t == scenario.end_ns || t == t_depth ||
+                         (!separate && t == t_frame);
+      if (whole) {
+        wholeStep(t, T_W_E, velocity);
+      } else {
+        tileStep(t, T_W_E, velocity);
+      }
       if (last_t == kNever) {
         result.first_depth = last.depth.clone();
         result.first_T_W_E = T_W_E;
       }
       last_t = t;
-      if (t < scenario.end_ns) {  // the next step, predicted from this (latest) sample
-        watch.restart();
-        next_event = t + predictor.interval(last.radiance, last.flow);
-        stats->schedule_s += watch.seconds();
-      }
     }
     if (!separate && frame && t == t_frame) addSample(last.radiance);
     if (frame && t == t_depth) {
@@ -248,7 +309,8 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
       frame->depth_done = true;
     }
     if (progress)
-      progress(SimulationProgress{nsToSeconds(t - scenario.start_ns), total_s, writer.eventCount(), stats->renders});
+      progress(SimulationProgress{nsToSeconds(t - scenario.start_ns), total_s, writer.eventCount(), stats->renders,
+                                  stats->tiles_rendered});
     if (t >= scenario.end_ns) break;
   }
   stats->pixel_updates = events_cam.pixelUpdates();

@@ -1,8 +1,10 @@
 #pragma once
 // The render scheduling loop of simulateSequence (sequence_simulator.h,
 // "Render scheduling"): renders the event camera at adaptive whole-frame
-// steps, frame sub-samples and frame stamps, and feeds the event camera, the
-// frame camera and the SequenceWriter in time order.
+// steps or, with sampling.schedule "tiles", re-renders only the tiles due
+// (tile_schedule.h); whole renders at frame sub-samples, frame stamps and the
+// end; feeds the event camera, the frame camera and the SequenceWriter in
+// time order.
 
 #include <opencv2/core/mat.hpp>
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "evio/core/cpu_features.h"
 #include "evio/core/error.h"
@@ -96,15 +97,45 @@ void Renderer::render(const Pose& T_W_C, const CameraVelocity* velocity, RenderO
   prepare(out.normal, CV_32FC3);
   if (velocity) prepare(out.flow, CV_32FC2);
   else out.flow.release();
-  const int t = options_.tile_px;
-  const int tiles = ((w + t - 1) / t) * ((h + t - 1) / t);
-  std::vector<RenderStats> counts(static_cast<std::size_t>(tiles));
+  renderTileList(T_W_C, velocity, nullptr, static_cast<std::size_t>(tileCount()), &out, stats);
+}
+
+cv::Rect Renderer::tileRect(int tile) const {
+  if (tile < 0 || tile >= tileCount()) throw Error("Renderer::tileRect: tile " + std::to_string(tile) + " out of range");
+  const int t = options_.tile_px, tiles_x = tilesX();
+  const int x0 = (tile % tiles_x) * t, y0 = (tile / tiles_x) * t;
+  return cv::Rect(x0, y0, std::min(t, camera_.width() - x0), std::min(t, camera_.height() - y0));
+}
+
+void Renderer::renderTiles(const Pose& T_W_C, const CameraVelocity* velocity, const int* tiles, std::size_t count,
+                           RenderOutput* out_ptr, RenderStats* stats) const {
+  const int w = camera_.width(), h = camera_.height(), n = tileCount();
+  RenderOutput& out = *out_ptr;
+  const auto check = [h, w](cv::Mat& m, int type, const char* name) {
+    if (m.rows != h || m.cols != w || m.type() != type)
+      throw Error(std::string("Renderer::renderTiles: ") + name + " is not the image of an earlier render of this camera");
+    if (m.u != nullptr && m.u->refcount > 1) m = m.clone();  // shared: keep the other's pixels
+  };
+  check(out.radiance, CV_32FC1, "radiance");
+  check(out.depth, CV_32FC1, "depth");
+  check(out.normal, CV_32FC3, "normal");
+  if (velocity) check(out.flow, CV_32FC2, "flow");
+  for (std::size_t i = 0; i < count; ++i)
+    if (tiles[i] < 0 || tiles[i] >= n)
+      throw Error("Renderer::renderTiles: tile " + std::to_string(tiles[i]) + " out of range");
+  if (options_.check_viewpoint && count > 0) scene_.checkViewpoint(T_W_C.translation());
+  renderTileList(T_W_C, velocity, tiles, count, &out, stats);
+}
+
+void Renderer::renderTileList(const Pose& T_W_C, const CameraVelocity* velocity, const int* tiles, std::size_t count,
+                              RenderOutput* out, RenderStats* stats) const {
+  std::vector<RenderStats> counts(count);
+  const auto tileAt = [tiles](std::size_t i) { return tiles ? tiles[i] : static_cast<int>(i); };
   tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       Scratch& s = scratch_->local.local();
-      for (int k = r.begin(); k != r.end(); ++k)
-        renderTile(k, T_W_C, velocity, &out, &counts[static_cast<std::size_t>(k)], &s);
+      for (std::size_t i = r.begin(); i != r.end(); ++i) renderTile(tileAt(i), T_W_C, velocity, out, &counts[i], &s);
     });
   });
   if (stats) {

@@ -1,4 +1,5 @@
 // Scenario options: validation and the sensor rig they describe.
+#include <algorithm>
 #include <cmath>
 
 #include "evio/core/error.h"
@@ -97,6 +98,14 @@ void RenderScheduleOptions::validate() const {
   requireField(fastest_pixel_quantile > 0.0 && fastest_pixel_quantile <= 1.0, "fastest_pixel_quantile",
                "must be in (0, 1]");
   requireInRange("supersampling", supersampling, 1, 8);
+  requireField(schedule == "whole_frame" || schedule == "tiles", "schedule", "must be whole_frame or tiles");
+  requireInRange("tile_px", tile_px, 1, 256);
+  requireField(tile_quantum_s == 0.0 || (tile_quantum_s >= 1e-6 && tile_quantum_s <= 1.0 / min_rate_hz),
+               "tile_quantum_s", "must be 0 or in [1e-6, 1 / min_rate_hz] s");
+}
+
+TimeNs RenderScheduleOptions::tileQuantumNs() const {
+  return std::max<TimeNs>(1, secondsToNs(tile_quantum_s > 0.0 ? tile_quantum_s : 1.0 / max_rate_hz));
 }
 
 void SequenceOutputOptions::validate() const {

@@ -160,6 +160,8 @@ std::string SimulationStats::toYaml() const {
   std::ostringstream s;
   s.precision(6);
   const double event_stage_rate = event_s > 0.0 ? static_cast<double>(pixel_updates) / event_s : 0.0;
+  const double equivalents =
+      tile_count > 0 ? static_cast<double>(tiles_rendered) / static_cast<double>(tile_count) : 0.0;
   s << "# evio simulate: what the run did and how long it took (wall clock; varies between runs)\n"
     << "simulated_s: " << simulated_s << "\n"
     << "wall_s: " << wall_s << "\n"
@@ -167,16 +169,23 @@ std::string SimulationStats::toYaml() const {
     << "cpu_s: " << cpu_s << "   # process CPU time, all threads (robust to other load on the machine)\n"
     << "simulated_s_per_cpu_s: " << (cpu_s > 0 ? simulated_s / cpu_s : 0.0) << "\n"
     << "resolution: [" << width << ", " << height << "]\n"
-    << "renders: " << renders << "\n"
+    << "schedule: " << schedule << "\n"
+    << "renders: " << renders << "   # whole-frame event-camera renders\n"
+    << "tile_steps: " << tile_steps << "   # steps that re-rendered only the tiles due\n"
+    << "tiles_rendered: " << tiles_rendered << "   # event-camera tiles traced, whole renders included\n"
+    << "tile_count: " << tile_count << "   # tiles per image\n"
+    << "render_equivalents: " << equivalents << "   # tiles_rendered / tile_count\n"
+    << "render_equivalents_per_simulated_s: " << (simulated_s > 0 ? equivalents / simulated_s : 0.0) << "\n"
     << "renders_per_simulated_s: " << (simulated_s > 0 ? static_cast<double>(renders) / simulated_s : 0.0) << "\n"
-    << "renders_per_wall_s: " << (render_s > 0 ? static_cast<double>(renders) / render_s : 0.0)
-    << "   # event-camera renders per second of render time\n"
+    << "renders_per_wall_s: " << (render_s > 0 ? equivalents / render_s : 0.0)
+    << "   # render equivalents per second of render time\n"
     << "frame_renders: " << frame_renders << "\n"
     << "pixel_updates: " << pixel_updates << "\n"
     << "event_stage_pixel_updates_per_s: " << event_stage_rate << "\n"
     << "event_stage_pixel_updates_per_cpu_s: "
     << (event_cpu_s > 0 ? static_cast<double>(pixel_updates) / event_cpu_s : 0.0) << "\n"
-    << "render_cpu_s_per_render: " << (renders > 0 ? render_cpu_s / static_cast<double>(renders) : 0.0) << "\n"
+    << "render_cpu_s_per_render: " << (equivalents > 0 ? render_cpu_s / equivalents : 0.0)
+    << "   # per render equivalent\n"
     << "events: " << events << "\n"
     << "events_per_simulated_s: " << (simulated_s > 0 ? static_cast<double>(events) / simulated_s : 0.0) << "\n"
     << "events_per_wall_s: " << (wall_s > 0 ? static_cast<double>(events) / wall_s : 0.0) << "\n"

@@ -1,6 +1,7 @@
 // Adaptive sampling: the sampler's rule (λ C / |∇L·u̇v| within the rate
 // bounds, per pixel or per tile), and the accuracy per-pixel adaptive
-// sampling keeps against whole-frame sampling at a fine step, on an analytic
+// sampling and the render loop's tile schedule keep against whole-frame
+// sampling at a fine step, on an analytic
 // texture rotating in the image with known flow (no renderer needed).
 #include "evio/simulator/adaptive_sampler.h"
 
@@ -13,6 +14,7 @@
 
 #include "evio/core/error.h"
 #include "evio/simulator/event_camera.h"
+#include "evio/simulator/tile_schedule.h"
 
 namespace evio::simulator {
 namespace {
@@ -112,7 +114,15 @@ struct Accuracy {
   double median_us = 0.0, p90_us = 0.0;  ///< |Δt| of the k-th events where counts agree
   double matched = 0.0;         ///< fraction of reference events so matched
   std::uint64_t updates = 0;    ///< pixel updates
+  double on_err = 0.0, off_err = 0.0;  ///< |n_adaptive − n_ref| / n_ref of ON and of OFF events
 };
+
+/// ON events of a stream.
+std::size_t onCount(const EventArray& ev) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < ev.size(); ++i) n += ev[i].positive ? 1 : 0;
+  return n;
+}
 
 Accuracy compare(const EventArray& ev_ref, const EventArray& ev_ada, int w, int h) {
   const auto pr = perPixel(ev_ref, w, h), pa = perPixel(ev_ada, w, h);
@@ -133,6 +143,12 @@ Accuracy compare(const EventArray& ev_ref, const EventArray& ev_ada, int w, int 
   a.median_us = dt_us[dt_us.size() / 2];
   a.p90_us = dt_us[dt_us.size() * 9 / 10];
   a.matched = static_cast<double>(dt_us.size()) / static_cast<double>(count_ref);
+  const auto rel = [](std::size_t n, std::size_t ref) {
+    return std::abs(static_cast<double>(n) - static_cast<double>(ref)) / static_cast<double>(ref);
+  };
+  const std::size_t on_ref = onCount(ev_ref), on_ada = onCount(ev_ada);
+  a.on_err = rel(on_ada, on_ref);
+  a.off_err = rel(ev_ada.size() - on_ada, ev_ref.size() - on_ref);
   return a;
 }
 
@@ -176,6 +192,51 @@ Accuracy runAdaptive(const RotatingTexture& tex, const EventCamera::Options& eo,
   for (std::size_t i = 1; i < ev_ada.size(); ++i) EXPECT_LE(ev_ada.t()[i - 1], ev_ada.t()[i]);
   Accuracy a = compare(ev_ref, ev_ada, w, h);
   a.updates = ada.pixelUpdates();
+  return a;
+}
+
+/// The render loop's tile schedule (tile_schedule.h) on the texture: at each
+/// 20 µs step the tiles due are sampled (EventCamera::updateRects) and
+/// rescheduled, then emit(); every tile is sampled at the last step.
+Accuracy runTiles(const RotatingTexture& tex, const EventCamera::Options& eo, int tile_px, TimeNs step, int steps,
+                  const EventArray& ev_ref) {
+  const int w = tex.w, h = tex.h;
+  const cv::Mat flow = tex.flow();
+  AdaptiveSampler::Options so;  // λ 0.5, the default rate bounds
+  TileSchedule schedule(w, h, tile_px, so, eo.threshold_pos, kEps, 0, step);
+  EventCamera cam(w, h, eo, 1);
+  EventArray ev;
+  cv::Mat img(h, w, CV_32FC1);
+  const auto render = [&](TimeNs t) {
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) img.at<float>(y, x) = tex.radianceAt(x, y, nsToSeconds(t));
+  };
+  render(0);
+  cam.update(0, img, &ev, nullptr);
+  schedule.scheduleAll(0, img, flow);
+  std::vector<int> due;
+  std::vector<cv::Rect> rects;
+  for (int k = 1; k <= steps; ++k) {
+    const TimeNs t = k * step;
+    if (k == steps) {
+      due.resize(static_cast<std::size_t>(schedule.tileCount()));
+      for (int q = 0; q < schedule.tileCount(); ++q) due[static_cast<std::size_t>(q)] = q;
+    } else {
+      schedule.dueTiles(t, &due);
+      EXPECT_GE(schedule.nextTime(), t);  // on the step grid no tile is ever overdue
+      if (due.empty()) continue;
+    }
+    render(t);
+    rects.clear();
+    for (const int q : due) rects.push_back(schedule.tileRect(q));
+    cam.updateRects(t, rects, img);
+    schedule.scheduleTiles(t, due, img, flow);
+    cam.emit(&ev, nullptr);
+  }
+  EXPECT_EQ(cam.pendingCount(), 0u);
+  for (std::size_t i = 1; i < ev.size(); ++i) EXPECT_LE(ev.t()[i - 1], ev.t()[i]);
+  Accuracy a = compare(ev_ref, ev, w, h);
+  a.updates = cam.pixelUpdates();
   return a;
 }
 
@@ -236,6 +297,24 @@ TEST(AdaptiveSampling, PerPixelSamplingKeepsTheAccuracyOfAFineWholeFrameStep) {
       EXPECT_LT(a.count_err, previous.count_err + 1e-3);
     }
     previous = a;
+  }
+  // Per tile (the render loop's "tiles" schedule): a tile's rate is that of
+  // its fastest pixel, so it is sampled at least as often as each of its
+  // pixels would be alone; the accuracy is at least the per-pixel one.
+  for (const int tile_px : {4, 8, 16}) {
+    const Accuracy a = runTiles(tex, eo, tile_px, step, steps, ev_ref);
+    std::cout << "  tiles of " << tile_px << " px, lambda 0.5: " << a.updates << " pixel updates ("
+              << ref_updates / static_cast<double>(a.updates) << "x fewer), count error " << 100.0 * a.count_err
+              << " % (ON " << 100.0 * a.on_err << " %, OFF " << 100.0 * a.off_err << " %), matched "
+              << 100.0 * a.matched << " %, time error median " << a.median_us << " us, p90 " << a.p90_us << " us\n";
+    EXPECT_LT(a.count_err, 0.01) << tile_px;
+    EXPECT_LT(a.on_err, 0.01) << tile_px;
+    EXPECT_LT(a.off_err, 0.01) << tile_px;
+    EXPECT_GT(a.matched, 0.95) << tile_px;
+    EXPECT_LT(a.median_us, 30.0) << tile_px;
+    EXPECT_LT(a.p90_us, 200.0) << tile_px;
+    EXPECT_LT(static_cast<double>(a.updates), 0.1 * ref_updates) << tile_px;
+    EXPECT_LT(a.updates, esim_updates) << tile_px;
   }
   EXPECT_GT(ev_ref.size(), 20000u);
 }

@@ -240,6 +240,63 @@ TEST(EventCamera, OutputIsSortedAndIndependentOfThreadsAndPixelOrder) {
   EXPECT_TRUE(a.labels == c.labels);
 }
 
+TEST(EventCamera, UpdateRectsIsUpdatePixelsForEveryPixelOfTheRectangles) {
+  const int w = 200, h = 180;  // > one parallel block of runs
+  // Tiles of 16 px (the last column and row narrower), a changing subset of
+  // them per step, every tile at least every third step.
+  std::vector<cv::Rect> tiles;
+  for (int y = 0; y < h; y += 16)
+    for (int x = 0; x < w; x += 16) tiles.emplace_back(x, y, std::min(16, w - x), std::min(16, h - y));
+  const auto subset = [&](int k) {
+    std::vector<cv::Rect> out;
+    for (std::size_t q = 0; q < tiles.size(); ++q)
+      if ((q + static_cast<std::size_t>(k)) % 3 != 0 || k % 5 == 0) out.push_back(tiles[q]);
+    return out;
+  };
+  const auto runRects = [&](int threads) {
+    EventCamera::Options o = noisy();
+    o.threads = threads;
+    EventCamera cam(w, h, o, 99);
+    EventRun run;
+    cam.update(0, frameAt(w, h, 0).data(), &run.events, &run.labels);
+    for (int k = 1; k <= 60; ++k) {
+      const auto img = frameAt(w, h, k);
+      cam.updateRects(k * 500'000, subset(k), cv::Mat(h, w, CV_32FC1, const_cast<float*>(img.data())));
+      cam.emit(&run.events, &run.labels);
+    }
+    return run;
+  };
+  EventCamera cam(w, h, noisy(), 99);
+  EventRun ref;
+  cam.update(0, frameAt(w, h, 0).data(), &ref.events, &ref.labels);
+  for (int k = 1; k <= 60; ++k) {
+    const auto img = frameAt(w, h, k);
+    std::vector<std::uint32_t> idx;
+    std::vector<float> val;
+    for (const cv::Rect& r : subset(k))
+      for (int y = r.y; y < r.y + r.height; ++y)
+        for (int x = r.x; x < r.x + r.width; ++x) {
+          idx.push_back(static_cast<std::uint32_t>(y * w + x));
+          val.push_back(img[idx.back()]);
+        }
+    cam.updatePixels(k * 500'000, idx.data(), val.data(), idx.size());
+    cam.emit(&ref.events, &ref.labels);
+  }
+  ASSERT_GT(ref.events.size(), 1000u);
+  for (const int threads : {1, 2}) {
+    const EventRun a = runRects(threads);
+    EXPECT_TRUE(a.events == ref.events) << threads;
+    EXPECT_TRUE(a.labels == ref.labels) << threads;
+  }
+  // Bad input changes nothing: overlapping or outside rectangles, a pixel not after its last sample.
+  const cv::Mat img(h, w, CV_32FC1, cv::Scalar(1.0f));
+  const std::uint64_t updates = cam.pixelUpdates();
+  EXPECT_THROW(cam.updateRects(40'000'000, {cv::Rect(0, 0, 16, 16), cv::Rect(8, 8, 16, 16)}, img), Error);
+  EXPECT_THROW(cam.updateRects(40'000'000, {cv::Rect(w - 8, 0, 16, 16)}, img), Error);
+  EXPECT_THROW(cam.updateRects(30'000'000, {cv::Rect(0, 0, 16, 16)}, img), Error);  // every tile is at 30 ms
+  EXPECT_EQ(cam.pixelUpdates(), updates);
+}
+
 TEST(EventCamera, PerPixelSamplesAreEmittedUpToTheWatermark) {
   EventCamera cam(2, 1, ideal(), 1);
   const std::vector<float> start = {radianceOfLog(0.0), radianceOfLog(0.0)};

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <tuple>
 
 #include "evio/core/cpu_features.h"
 #include "evio/core/error.h"
@@ -369,6 +370,67 @@ TEST(Renderer, Avx2PathRendersTheSameBitsAsTheBaselinePath) {
     }
     }
   }
+}
+
+/// Whether the pixels of `rect` in a and b have the same bits.
+bool rectBitEqual(const cv::Mat& a, const cv::Mat& b, const cv::Rect& rect) {
+  for (int y = rect.y; y < rect.y + rect.height; ++y)
+    if (std::memcmp(a.ptr(y, rect.x), b.ptr(y, rect.x), static_cast<std::size_t>(rect.width) * a.elemSize()) != 0)
+      return false;
+  return true;
+}
+
+TEST(Renderer, RenderTilesGivesTheTilesTheBitsOfAWholeRenderAndLeavesTheRest) {
+  const Scene scene(loadSceneString(kEveryShadingFeature, "s.yaml"));
+  const CameraVelocity vel{Vec3(0.3, 0, 0.1), Vec3(0, 0.2, 0.05)};
+  const Vec3 c0(0, -4, 2.5), c1(0.1, -3.9, 2.45);
+  const Pose T0(scenes::lookAtRotation(c0, Vec3(0, 0.5, 0.5), Vec3::UnitZ()), c0);
+  const Pose T1(scenes::lookAtRotation(c1, Vec3(0, 0.6, 0.5), Vec3::UnitZ()), c1);
+  // Both shading paths, supersampling, and tiles that do not divide the image.
+  for (const auto& [n, tile, avx2] : {std::tuple{1, 8, true}, std::tuple{1, 13, true}, std::tuple{2, 8, true},
+                                      std::tuple{1, 13, false}, std::tuple{2, 13, false}}) {
+    SCOPED_TRACE(::testing::Message() << "supersampling " << n << ", tiles of " << tile << " px, avx2 " << avx2);
+    RendererOptions o = threads(2);
+    o.supersampling = n;
+    o.tile_px = tile;
+    o.avx2 = avx2;
+    const Renderer r(scene, radtan(97, 71), o);
+    ASSERT_EQ(r.tileCount(), ((97 + tile - 1) / tile) * ((71 + tile - 1) / tile));
+    const RenderOutput before = r.render(T0, &vel), after = r.render(T1, &vel);
+    ASSERT_FALSE(bitEqual(before.radiance, after.radiance));
+    RenderOutput out{before.radiance.clone(), before.depth.clone(), before.normal.clone(), before.flow.clone()};
+    const cv::Mat alias = out.radiance;  // shared: renderTiles must copy, not write into it
+    std::vector<int> tiles;
+    for (int k = 0; k < r.tileCount(); k += 3) tiles.push_back(k);
+    tiles.push_back(r.tileCount() - 1);  // the narrow corner tile
+    RenderStats stats;
+    r.renderTiles(T1, &vel, tiles.data(), tiles.size(), &out, &stats);
+    EXPECT_GT(stats.camera_rays, 0u);
+    EXPECT_TRUE(bitEqual(alias, before.radiance));
+    for (int k = 0; k < r.tileCount(); ++k) {
+      const bool rendered = std::count(tiles.begin(), tiles.end(), k) > 0;
+      const RenderOutput& expected = rendered ? after : before;
+      const cv::Rect rect = r.tileRect(k);
+      EXPECT_TRUE(rectBitEqual(out.radiance, expected.radiance, rect)) << "tile " << k;
+      EXPECT_TRUE(rectBitEqual(out.depth, expected.depth, rect)) << "tile " << k;
+      EXPECT_TRUE(rectBitEqual(out.normal, expected.normal, rect)) << "tile " << k;
+      EXPECT_TRUE(rectBitEqual(out.flow, expected.flow, rect)) << "tile " << k;
+    }
+    // Every tile re-rendered: the whole render.
+    std::vector<int> all(static_cast<std::size_t>(r.tileCount()));
+    for (int k = 0; k < r.tileCount(); ++k) all[static_cast<std::size_t>(k)] = k;
+    r.renderTiles(T1, &vel, all.data(), all.size(), &out);
+    EXPECT_TRUE(bitEqual(out.radiance, after.radiance));
+    EXPECT_TRUE(bitEqual(out.flow, after.flow));
+  }
+  const Renderer r(scene, radtan(97, 71), threads(1));
+  RenderOutput empty;
+  const int tile0 = 0, bad = r.tileCount();
+  EXPECT_THROW(r.renderTiles(T0, &vel, &tile0, 1, &empty), Error);  // no earlier render
+  RenderOutput out = r.render(T0);
+  EXPECT_THROW(r.renderTiles(T0, &vel, &tile0, 1, &out), Error);  // no flow image to write
+  EXPECT_THROW(r.renderTiles(T0, nullptr, &bad, 1, &out), Error);
+  EXPECT_THROW(r.tileRect(-1), Error);
 }
 
 TEST(Renderer, CameraInsideGeometryIsOneClearError) {

@@ -100,6 +100,11 @@ rig:
   EXPECT_NE(e.find("bogus_key"), std::string::npos) << e;
   e = load("duration_s: -1\n");
   EXPECT_NE(e.find("duration_s"), std::string::npos) << e;
+  e = load("sampling: {schedule: tile}\n");
+  EXPECT_NE(e.find("sampling.schedule"), std::string::npos) << e;
+  EXPECT_NE(e.find("whole_frame or tiles"), std::string::npos) << e;
+  e = load("sampling: {tile_quantum_s: 1}\n");
+  EXPECT_NE(e.find("tile_quantum_s"), std::string::npos) << e;
   e = load("duration_s: 100\n");  // the hover preset lasts 60 s
   EXPECT_NE(e.find("past the end of the trajectory"), std::string::npos) << e;
   e = load("  frame_camera: {rate_hz: 20, sensor: {auto_exposure: false, exposure_s: 0.04, readout_s: 0.02}}\n");

@@ -70,6 +70,17 @@ std::vector<std::string> filesBelow(const fs::path& dir) {
   return out;
 }
 
+/// Whether every file below a and b (simulation_stats.yaml aside: wall-clock
+/// times) has the same bytes, the lists of files equal.
+void expectSameFiles(const test::TempDir& tmp, const std::string& a, const std::string& b) {
+  const auto files = filesBelow(tmp.path() / a);
+  ASSERT_EQ(files, filesBelow(tmp.path() / b));
+  for (const auto& f : files) {
+    if (f == "simulation_stats.yaml") continue;
+    EXPECT_EQ(io::readFile(tmp.file(a + "/" + f)), io::readFile(tmp.file(b + "/" + f))) << f << " differs";
+  }
+}
+
 TEST(SequenceSimulator, ByteIdenticalWithOneAndTwoThreads) {
   test::TempDir tmp;
   const auto a = simulateSequence(loadTestScenario({"threads=1"}), tmp.file("a"));
@@ -78,16 +89,51 @@ TEST(SequenceSimulator, ByteIdenticalWithOneAndTwoThreads) {
   EXPECT_EQ(a.events, b.events);
   EXPECT_EQ(a.renders, b.renders);
   const auto files = filesBelow(tmp.path() / "a");
-  ASSERT_EQ(files, filesBelow(tmp.path() / "b"));
   for (const char* expected :
        {"events.h5", "events.txt", "images.txt", "imu.txt", "groundtruth.txt", "calib.txt", "sensors.yaml",
         "scenario.yaml", "range.txt", "simulation_stats.yaml", "truth/imu_state.txt", "truth/event_labels.bin",
         "truth/depth.txt", "truth/track_points.txt", "truth/tracks.txt", "truth/tracks_occluded.txt",
         "truth/range.txt", "images/frame_00000000.png", "truth/depth/depth_00000000.exr"})
     EXPECT_TRUE(std::count(files.begin(), files.end(), expected)) << expected;
-  for (const auto& f : files) {
-    if (f == "simulation_stats.yaml") continue;  // wall-clock times
-    EXPECT_EQ(io::readFile(tmp.file("a/" + f)), io::readFile(tmp.file("b/" + f))) << f << " differs";
+  expectSameFiles(tmp, "a", "b");
+}
+
+TEST(SequenceSimulator, TileScheduleIsByteIdenticalWithOneAndTwoThreadsAndKeepsFramesExact) {
+  test::TempDir tmp;
+  const auto a = simulateSequence(loadTestScenario({"threads=1", "sampling.schedule=tiles", "sampling.tile_px=8"}),
+                                  tmp.file("a"));
+  const auto b = simulateSequence(loadTestScenario({"threads=2", "sampling.schedule=tiles", "sampling.tile_px=8"}),
+                                  tmp.file("b"));
+  ASSERT_GT(a.events, 100u);
+  EXPECT_EQ(a.schedule, "tiles");
+  EXPECT_GT(a.tile_steps, 0u);  // the tile steps ran, and traced fewer tiles than whole renders would have
+  EXPECT_LT(a.tiles_rendered, (a.renders + a.tile_steps) * a.tile_count);
+  EXPECT_EQ(a.tile_count, 8u * 6u);
+  EXPECT_EQ(a.tiles_rendered, b.tiles_rendered);
+  expectSameFiles(tmp, "a", "b");
+  // The stream written step by step up to each watermark is time-sorted,
+  // inside the window, one label per event.
+  const Scenario scenario = loadTestScenario();
+  const EventArray ev = io::readEventsText(tmp.file("a/events.txt"), io::SensorSize{64, 48});
+  ASSERT_EQ(ev.size(), a.events);
+  for (std::size_t i = 1; i < ev.size(); ++i) ASSERT_LE(ev.t()[i - 1], ev.t()[i]) << i;
+  EXPECT_GE(ev.t().front(), scenario.start_ns);
+  EXPECT_LE(ev.t().back(), scenario.end_ns);
+  EXPECT_EQ(io::readEventLabels(tmp.file("a/truth/event_labels.bin")).size(), a.events);
+  // Frames and depth come from whole renders at the same times in either
+  // schedule: the same bytes as the whole-frame schedule's.
+  const auto w = simulateSequence(loadTestScenario({"threads=2"}), tmp.file("w"));
+  EXPECT_EQ(w.schedule, "whole_frame");
+  EXPECT_EQ(w.tile_steps, 0u);
+  EXPECT_EQ(w.tiles_rendered, w.renders * w.tile_count);
+  ASSERT_GT(a.frames, 5u);
+  EXPECT_EQ(a.frames, w.frames);
+  EXPECT_EQ(a.depth_maps, w.depth_maps);
+  for (const auto& f : filesBelow(tmp.path() / "a")) {
+    if (f.rfind("images", 0) == 0 || f.rfind("truth/depth", 0) == 0 || f == "imu.txt" || f == "groundtruth.txt" ||
+        f.rfind("truth/track", 0) == 0) {
+      EXPECT_EQ(io::readFile(tmp.file("a/" + f)), io::readFile(tmp.file("w/" + f))) << f << " differs";
+    }
   }
 }
 

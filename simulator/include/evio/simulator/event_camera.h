@@ -79,9 +79,9 @@
 ///    event up to t is emitted, time-sorted, appended to `events`.
 ///  - Adaptive, per pixel: after one whole-frame `update` (or `initialize`),
 ///    feed the pixels of each render with `updatePixels(t, indices, I, n)` or
-///    `updatePixel(i, t, I)` (each pixel's times strictly increasing; the
-///    same result either way), then call `emit(&events, &labels)` once per
-///    render: it appends, time-sorted, every event at or before the watermark
+///    `updatePixel(i, t, I)`, or whole tiles with `updateRects(t, rects, I)`
+///    (each pixel's times strictly increasing; the same result any way),
+///    then call `emit(&events, &labels)` once per render: it appends, time-sorted, every event at or before the watermark
 ///    = the earliest last-sample time over all pixels, and keeps the rest
 ///    pending. Events after the watermark can still be preceded by events of
 ///    pixels not yet sampled that far, so they wait. To end a sequence at
@@ -93,6 +93,7 @@
 #include <memory>
 #include <opencv2/core/mat.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "evio/core/event.h"
@@ -211,6 +212,15 @@ class EventCamera {
   /// each, faster; every sample is checked before any pixel changes.
   void updatePixels(TimeNs t_ns, const std::uint32_t* indices, const float* radiance, std::size_t count);
 
+  /// The pixels of the image rectangles `rects` (inside the image, not
+  /// overlapping) all sampled at t_ns, their radiance read from the whole
+  /// image `radiance` (CV_32FC1, continuous, width × height; other pixels are
+  /// not read): the same as updatePixel for each pixel, run by run of a row
+  /// through the vectorised path of update(), blocks in parallel (the result
+  /// does not depend on the thread count). Every sample is checked before
+  /// any pixel changes. Events wait in the pending buffer until emit().
+  void updateRects(TimeNs t_ns, const std::vector<cv::Rect>& rects, const cv::Mat& radiance);
+
   /// Appends, time-sorted, the pending events at or before the watermark
   /// (min over pixels of the last sample time) plus the leak and hot-pixel
   /// noise up to it; returns the watermark. O(pixels + pending events).
@@ -301,6 +311,8 @@ class EventCamera {
   std::vector<Pending> pending_;
   std::vector<std::uint64_t> sort_keys_, sort_scratch_;
   std::vector<std::vector<Pending>> block_events_;
+  std::vector<std::pair<std::size_t, std::size_t>> runs_;  ///< updateRects: [begin, end) of each row run
+  std::vector<std::size_t> block_starts_;                   ///< updateRects: first run of each block (+ the end)
   std::uint64_t pixel_updates_ = 0;
 };
 

@@ -91,6 +91,23 @@ class Renderer {
   void render(const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
               RenderStats* stats = nullptr) const;
 
+  /// The tiles the image is cut into: squares of options().tile_px pixels
+  /// (narrower in the last column and row), numbered row-major from the
+  /// top-left corner; tile k covers tileRect(k) = [x0, x1) × [y0, y1).
+  int tilesX() const { return (camera_.width() + options_.tile_px - 1) / options_.tile_px; }
+  int tileCount() const { return tilesX() * ((camera_.height() + options_.tile_px - 1) / options_.tile_px); }
+  cv::Rect tileRect(int tile) const;
+
+  /// Re-traces only the tiles tiles[0 .. count) (each in [0, tileCount()),
+  /// no repeats) into *out, which must hold the images of an earlier render
+  /// of this camera (flow too when `velocity` is given; throws otherwise).
+  /// Every pixel of those tiles gets the same bits as render() at T_W_C
+  /// would give it; the other pixels keep their values. An image that is
+  /// shared with another cv::Mat is copied first (the other keeps its pixels).
+  /// `stats` counts the rays of these tiles.
+  void renderTiles(const Pose& T_W_C, const CameraVelocity* velocity, const int* tiles, std::size_t count,
+                   RenderOutput* out, RenderStats* stats = nullptr) const;
+
   /// Unit bearing in C of the centre ray of pixel (x, y); NaN when the model
   /// cannot unproject that pixel.
   Eigen::Vector3f bearing(int x, int y) const {
@@ -104,6 +121,10 @@ class Renderer {
  private:
   struct Scratch;
   struct ScratchPool;  ///< per-thread Scratch, kept from render to render
+  /// Renders tiles[0 .. count) (nullptr: tiles 0 .. count) in parallel into
+  /// *out, whose images have the right size and type.
+  void renderTileList(const Pose& T_W_C, const CameraVelocity* velocity, const int* tiles, std::size_t count,
+                      RenderOutput* out, RenderStats* stats) const;
   void renderTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
                   RenderStats* counts, Scratch* scratch) const;
   /// renderTile compiled for AVX2 (called only when avx2_).

@@ -42,6 +42,7 @@
 #include "evio/core/io/events_h5.h"
 #include "evio/core/options.h"
 #include "evio/core/sensor_rig.h"
+#include "evio/core/time.h"
 #include "evio/scenes/scene_description.h"
 #include "evio/simulator/event_sensor_preset.h"
 #include "evio/simulator/frame_camera.h"
@@ -164,23 +165,36 @@ struct RigOptions {
 /// Ṙ_q the q-quantile over pixels of the predicted |dL/dt| (AdaptiveSampler:
 /// rate_bound as there), q = fastest_pixel_quantile (1: the fastest pixel, ESIM).
 struct RenderScheduleOptions {
+  /// "whole_frame": every step re-renders the whole image, at the interval
+  /// predicted from the fastest-pixel quantile; "tiles": every tile of
+  /// tile_px has its own next-sample time from its fastest pixel
+  /// (tile_schedule.h) and a step re-renders only the tiles due.
+  std::string schedule = "whole_frame";
   double lambda = 0.5;                ///< λ: fraction of the threshold L may change between renders
-  double min_rate_hz = 100.0;         ///< renders at least this often, Hz
-  double max_rate_hz = 1000.0;        ///< at most this often (cost bound), Hz
+  double min_rate_hz = 100.0;         ///< renders at least this often, Hz (per tile with "tiles")
+  double max_rate_hz = 1000.0;        ///< at most this often (cost bound), Hz (per tile with "tiles")
   bool rate_bound = true;             ///< predict with max neighbour slope · |flow| (else |∇L · flow|)
-  double fastest_pixel_quantile = 1.0;///< q ∈ (0, 1]: 1 = the fastest pixel
+  double fastest_pixel_quantile = 1.0;///< q ∈ (0, 1]: 1 = the fastest pixel ("whole_frame" only)
+  int tile_px = 16;                   ///< render tile edge, px (the schedule's tiles with "tiles"); the renderer's default
+  double tile_quantum_s = 0.0;        ///< "tiles": due times on a grid of this period, s; 0 = 1 / max_rate_hz
   int supersampling = 1;              ///< n × n radiance rays per pixel
 
   template <class V>
   void fields(V& v) {
+    v("schedule", schedule, "whole_frame (whole renders) or tiles (per-tile adaptive renders)");
     v("lambda", lambda, "fraction of the contrast threshold between renders");
     v("min_rate_hz", min_rate_hz, "minimum render rate, Hz");
     v("max_rate_hz", max_rate_hz, "maximum render rate, Hz");
     v("rate_bound", rate_bound, "predict with max neighbour slope * |flow| (else |grad L . flow|)");
     v("fastest_pixel_quantile", fastest_pixel_quantile, "pixel quantile of the predicted rate (1 = fastest)");
+    v("tile_px", tile_px, "render tile edge, px (the schedule's tiles with schedule: tiles)");
+    v("tile_quantum_s", tile_quantum_s, "tiles: due times on a grid of this period, s (0 = 1 / max_rate_hz)");
     v("supersampling", supersampling, "n x n radiance rays per pixel");
   }
   void validate() const;
+  bool tiles() const { return schedule == "tiles"; }
+  /// The grid period of the "tiles" schedule, ns.
+  TimeNs tileQuantumNs() const;
 };
 
 struct SequenceOutputOptions {

@@ -22,12 +22,14 @@
 ///   simulation_stats.yaml counts and wall-clock times (the only file that
 ///                         differs between two runs)
 ///
-/// Render scheduling. The renderer traces whole images only (renderer.h has
-/// no call for a subset of pixels), so the event camera is sampled by whole
-/// frames at adaptive steps: after a render at t the next one is due after
-/// Δt = clamp(λ C / Ṙ_q, 1 / max_rate_hz, 1 / min_rate_hz) (scenario.h,
-/// RenderScheduleOptions), Ṙ_q from the rendered radiance and the analytic
-/// motion field. Renders are also placed at every frame sub-sample (a
+/// Render scheduling (scenario.h, RenderScheduleOptions::schedule).
+/// "whole_frame": the event camera is sampled by whole frames at adaptive
+/// steps: after a render at t the next one is due after
+/// Δt = clamp(λ C / Ṙ_q, 1 / max_rate_hz, 1 / min_rate_hz), Ṙ_q from the
+/// rendered radiance and the analytic motion field. "tiles": each tile has
+/// its own next-sample time (tile_schedule.h) and a step re-renders only the
+/// tiles due (Renderer::renderTiles), feeding their pixels to the event
+/// camera (EventCamera::updateRects). Whole renders are also placed at every frame sub-sample (a
 /// co-located frame camera shares the event camera's renders and feeds them
 /// to the event camera too), at every frame stamp (depth truth) and at the
 /// end of the window. A separate frame camera renders its own sub-samples.
@@ -53,7 +55,8 @@ struct SimulationProgress {
   double simulated_s = 0.0;  ///< sequence time done, s
   double total_s = 0.0;      ///< sequence length, s
   std::uint64_t events = 0;
-  std::uint64_t renders = 0;
+  std::uint64_t renders = 0;         ///< whole-frame renders of the event camera
+  std::uint64_t tiles_rendered = 0;  ///< event-camera tiles traced, whole renders included
 };
 using ProgressCallback = std::function<void(const SimulationProgress&)>;
 
@@ -73,7 +76,11 @@ struct SimulationStats {
   double event_cpu_s = 0.0;          ///< CPU time (all threads) of EventCamera::update
   double truth_s = 0.0;              ///< ground truth, IMU, range, tracks passes
   int width = 0, height = 0;         ///< event sensor, px
-  std::uint64_t renders = 0;         ///< event-camera renders
+  std::string schedule;              ///< sampling.schedule: whole_frame or tiles
+  std::uint64_t renders = 0;         ///< whole-frame event-camera renders
+  std::uint64_t tile_steps = 0;      ///< steps that re-rendered only the tiles due ("tiles")
+  std::uint64_t tiles_rendered = 0;  ///< event-camera tiles traced (whole renders included)
+  std::uint64_t tile_count = 0;      ///< tiles per event-camera image
   std::uint64_t frame_renders = 0;   ///< separate frame-camera renders
   std::uint64_t pixel_updates = 0;   ///< event-camera pixel samples
   std::uint64_t events = 0;

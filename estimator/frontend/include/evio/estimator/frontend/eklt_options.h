@@ -69,9 +69,10 @@ struct EkltOptions {
   // Measurement covariance (eklt_cost.h ekltPositionCovariance).
   /// Attach to each track point the covariance of its position from the
   /// curvature of the cost at the solution (else none: the backend's σ_img).
-  /// Off by default until the campaigns on the calibrated sensors decide
-  /// (README "Consistency": better on the legacy poster, worse on the Mars yard).
-  bool position_covariance = false;
+  /// On by default: with repeated points dropped, the lowest median error
+  /// on poster, shapes and boxes on the calibrated sensors (campaign
+  /// eklt_variants, README "EKLT on real-like events").
+  bool position_covariance = true;
   /// Floor of the position σ along any direction, px. The curvature sees
   /// only the noise of one batch (0.05–0.5 px); a track's error is mostly
   /// what persists from batch to batch (template drift, the bias and latency

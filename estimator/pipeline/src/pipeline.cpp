@@ -32,6 +32,21 @@ class StageTimer {
   Stopwatch watch_;
 };
 
+/// Process CPU time between successive laps: lap(&acc) adds the CPU seconds
+/// since the previous lap (or construction) to acc.
+class CpuLap {
+ public:
+  CpuLap() : last_(Stopwatch::processCpuSecondsPrecise()) {}
+  void lap(double* acc) {
+    const double now = Stopwatch::processCpuSecondsPrecise();
+    *acc += now - last_;
+    last_ = now;
+  }
+
+ private:
+  double last_;
+};
+
 /// One run of the pipeline; see pipeline.h. setup() builds the stages once;
 /// loop() reads the sequence and hands every item down the chain
 /// (runStages), then checks the run's health and writes progress and timing.
@@ -208,17 +223,23 @@ void PipelineRun::setupStages() {
 }
 
 void PipelineRun::runStages(SequenceItem& item) {
+  PipelineStageCpu& cpu = result_.cpu;
+  CpuLap lap;
   backend_inputs_.clear();
   {
     StageTimer timer(&result_.times.frontend_s);
     if (tracks_) {
       tracks_->process(item, backend_inputs_);
+      lap.lap(&cpu.sync_s);
     } else {
       filtered_.clear();
       tracked_.clear();
       prefilter_->process(item, filtered_);
+      lap.lap(&cpu.prefilter_s);
       for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
+      lap.lap(&cpu.tracking_s);
       for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs_);
+      lap.lap(&cpu.sync_s);
       if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
     }
   }
@@ -227,10 +248,14 @@ void PipelineRun::runStages(SequenceItem& item) {
     StageTimer timer(&result_.times.backend_s);
     for (BackendInput& in : backend_inputs_) backend_stage_->process(in, estimates_);
   }
+  lap.lap(&cpu.backend_s);
   checked_.clear();
   for (Estimate& e : estimates_) health_->process(e, checked_);
-  StageTimer timer(&result_.times.output_s);
-  for (const Estimate& e : checked_) writer_->addEstimate(e);
+  {
+    StageTimer timer(&result_.times.output_s);
+    for (const Estimate& e : checked_) writer_->addEstimate(e);
+  }
+  lap.lap(&cpu.output_s);
 }
 
 void PipelineRun::afterItem(TimeNs t_ns) {
@@ -271,9 +296,12 @@ void PipelineRun::loop() {
   while (true) {
     {
       StageTimer timer(&result_.times.read_s);
-      if (!reader_->next(item)) break;
-      if (item.kind == SequenceItem::Kind::kFrame)
+      CpuLap lap;
+      const bool more = reader_->next(item);
+      if (more && item.kind == SequenceItem::Kind::kFrame)
         item.image = reader_->loadFrame(item.frame_index, frame_size_, frame_size_from_);
+      lap.lap(&result_.cpu.read_s);
+      if (!more) break;
     }
     if (!any_item_) {
       result_.t_first_ns = item.kind == SequenceItem::Kind::kEvents ? item.events.t().front() : item.t_ns;
@@ -296,6 +324,11 @@ void PipelineRun::loop() {
     result_.counts.events_kept = prefilter_->numEventsKept();
     result_.counts.frames = frontend_->numFrames();
     result_.counts.track_points = sync_->numTrackPoints();
+    if (const EkltTiming* t = frontend_->ekltTiming()) {
+      result_.cpu.eklt_optimisation_s = t->optimisation_s;
+      result_.cpu.eklt_events_s = t->splattingS();
+      result_.cpu.eklt_frames_s = t->frame_s;
+    }
   }
   result_.counts.measurement_sets = backend_stage_->numMeasurementSets();
 }

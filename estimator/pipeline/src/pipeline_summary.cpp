@@ -37,6 +37,8 @@ std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions
   writer.write(r.counts);
   out << YAML::Key << "stage_times_s" << YAML::Value;
   writer.write(r.times);
+  out << YAML::Key << "stage_cpu_s" << YAML::Value;
+  writer.write(r.cpu);
   out << YAML::Key << "backend" << YAML::Value;
   writer.write(r.backend);
   out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;

@@ -28,6 +28,11 @@ void PrefilterStage::process(SequenceItem& in, std::vector<SequenceItem>& out) {
 FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera)
     : frontend_(options, camera.camera, camera.T_B_C) {}
 
+const EkltTiming* FrontendStage::ekltTiming() const {
+  const auto* eklt = dynamic_cast<const EkltTracker*>(&frontend_.tracker());
+  return eklt ? &eklt->timing() : nullptr;
+}
+
 void FrontendStage::process(SequenceItem& in, std::vector<FrontendOutput>& out) {
   FrontendOutput& o = out.emplace_back();
   o.kind = in.kind;

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <ctime>
 
+#include <time.h>
+
 namespace evio {
 
 class Stopwatch {
@@ -23,7 +25,19 @@ class Stopwatch {
   /// Differences of two readings time a piece of work.
   static double processCpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
+  /// CPU time of the process (all threads), s, with ns resolution
+  /// (clock_gettime CLOCK_PROCESS_CPUTIME_ID); about 0.3 µs per call.
+  static double processCpuSecondsPrecise() { return cpuClockSeconds(CLOCK_PROCESS_CPUTIME_ID); }
+
+  /// CPU time of the calling thread, s (CLOCK_THREAD_CPUTIME_ID).
+  static double threadCpuSeconds() { return cpuClockSeconds(CLOCK_THREAD_CPUTIME_ID); }
+
  private:
+  static double cpuClockSeconds(clockid_t id) {
+    timespec ts{};
+    clock_gettime(id, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  }
   using Clock = std::chrono::steady_clock;
   Clock::time_point start_;
 };

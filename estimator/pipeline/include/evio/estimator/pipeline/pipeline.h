@@ -81,6 +81,37 @@ struct PipelineStageTimes {
   }
 };
 
+/// CPU seconds per stage (process CPU clock, so the tracker's worker threads
+/// count with the tracking stage), summed over the run; read once per stage
+/// and input item (a chunk of events, a frame, an IMU sample), never per
+/// event. The `eklt_*` entries split EKLT's tracking time as the tracker
+/// itself measures it (wall seconds summed over its threads; 0 for the other
+/// trackers).
+struct PipelineStageCpu {
+  double read_s = 0.0;       ///< reading events, IMU and frames (decoding PNG included)
+  double prefilter_s = 0.0;  ///< event pre-filters
+  double tracking_s = 0.0;   ///< the frontend: reconstruction and tracker
+  double sync_s = 0.0;       ///< synchroniser (tracks_ method: reading the tracks)
+  double backend_s = 0.0;    ///< EKF propagation and updates
+  double output_s = 0.0;     ///< health monitor and writing the estimate files
+  double eklt_optimisation_s = 0.0;  ///< EKLT: the per-batch optimisations
+  double eklt_events_s = 0.0;        ///< EKLT: event lookup and splatting (events minus optimisation)
+  double eklt_frames_s = 0.0;        ///< EKLT: frames (log image, gradients, templates, detection, bootstrap)
+
+  template <class V>
+  void fields(V& v) {
+    v("read_s", read_s, "reading events, IMU and frames, CPU s");
+    v("prefilter_s", prefilter_s, "event pre-filters, CPU s");
+    v("tracking_s", tracking_s, "frontend (reconstruction and tracker), CPU s");
+    v("sync_s", sync_s, "synchroniser, CPU s");
+    v("backend_s", backend_s, "EKF propagation and updates, CPU s");
+    v("output_s", output_s, "health monitor and estimate files, CPU s");
+    v("eklt_optimisation_s", eklt_optimisation_s, "EKLT optimisations, s summed over tracker threads");
+    v("eklt_events_s", eklt_events_s, "EKLT event lookup and splatting, s summed over tracker threads");
+    v("eklt_frames_s", eklt_frames_s, "EKLT frames: log image, gradients, templates, detection, bootstrap, s");
+  }
+};
+
 /// What went through the chain (summary.yaml `counts`).
 struct PipelineCounts {
   std::uint64_t events = 0;            ///< events read
@@ -107,6 +138,7 @@ struct PipelineResult {
   io::EstimateStatus status;
   BackendStats backend;
   PipelineStageTimes times;
+  PipelineStageCpu cpu;
   PipelineCounts counts;
   std::string rig_source;          ///< sensors.yaml or calib.txt
   std::string tracker_camera;      ///< camera whose pixels the tracker used

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "evio/estimator/backend/backend.h"
+#include "evio/estimator/frontend/eklt_tracker.h"
 #include "evio/estimator/frontend/event_prefilter.h"
 #include "evio/estimator/frontend/frontend.h"
 #include "evio/estimator/frontend/synchronizer.h"
@@ -65,6 +66,8 @@ class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
   FrontendStage(const FrontendOptions& options, const CameraSensor& camera);
   void process(SequenceItem& in, std::vector<FrontendOutput>& out) override;
   std::uint64_t numFrames() const { return frames_; }
+  /// The EKLT tracker's own time split; null for the other trackers.
+  const EkltTiming* ekltTiming() const;
 
  private:
   Frontend frontend_;

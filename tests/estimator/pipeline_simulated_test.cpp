@@ -11,7 +11,9 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
+#include "evio/core/io/atomic_file.h"
 #include "evio/core/io/config.h"
 #include "evio/core/io/tum.h"
 #include "evio/estimator/pipeline/groundtruth_init.h"
@@ -83,6 +85,28 @@ test::TempDir* PipelineSimulated::dir_ = nullptr;
 TEST_F(PipelineSimulated, EkltVio) {
   PipelineOptions o = fromGroundTruth("eklt-vio");
   runAndCheck(o, "eklt", 60);  // an update every 3200 events: more than one per frame
+}
+
+// Features tracked on 1, 2 or 3 threads (frontend.threads): the estimate
+// files are the same bytes (eklt_tracker.h: fixed partition, merge in the
+// single-thread order).
+TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCount) {
+  std::vector<std::string> outs;
+  for (int threads : {1, 2, 3}) {
+    PipelineOptions o = fromGroundTruth("eklt-vio");
+    o.frontend.threads = threads;
+    o.frontend.eklt.position_covariance = true;
+    outs.push_back(dir_->file("eklt_threads_" + std::to_string(threads)));
+    const PipelineResult r = runPipeline(sequence(), o, outs.back());
+    ASSERT_TRUE(r.status.ok()) << r.status.cause;
+    ASSERT_GT(r.counts.measurement_sets, 60u);
+  }
+  for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt"}) {
+    const std::string one = io::readFile(outs[0] + "/" + file);
+    EXPECT_FALSE(one.empty()) << file;
+    for (std::size_t k = 1; k < outs.size(); ++k)
+      EXPECT_TRUE(one == io::readFile(outs[k] + "/" + file)) << file << ", " << k + 1 << " threads";
+  }
 }
 
 TEST_F(PipelineSimulated, KltVio) { runAndCheck(fromGroundTruth("klt-vio"), "klt", 40); }

@@ -75,7 +75,21 @@ struct EkltTracker::Slot {
   PixelRect rect;              // where the grid has this slot's bit
 };
 
-EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
+/// One part of the feature partition (eklt_tracker.h): slots s with
+/// s mod parts == its index.
+struct EkltTracker::Part {
+  Part(int width, int height, int num_slots, std::size_t patch_pixels)
+      : grid(width, height, num_slots), measured(patch_pixels, 0.0f) {
+    points.reserve(256);
+  }
+  FeatureGrid grid;                // the bits of this part's slots only
+  std::vector<float> measured;     // normalised batch, P²
+  std::vector<ChunkPoint> points;  // of the current chunk, in (event, slot) order
+  EkltTiming timing;               // events_s, optimisation_s and counters of the current chunk
+};
+
+EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::optional<Pose> T_B_C,
+                         int threads)
     : options_(options),
       solver_(parseEkltSolverKind(options.solver)),
       camera_(camera),
@@ -85,9 +99,9 @@ EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::
       // The warp rotates the patch (corner at h√2) and moves its centre by
       // up to a few px per batch; 6 px more cover that and the bicubic taps.
       template_radius_(static_cast<int>(std::ceil(half_ * std::sqrt(2.0))) + 6),
-      slots_(static_cast<std::size_t>(options.max_features)),
-      grid_(camera.width(), camera.height(), options.max_features) {
+      slots_(static_cast<std::size_t>(options.max_features)) {
   options_.validate();
+  require(threads >= 1 && threads <= 256, "EkltTracker: threads must be in [1, 256]");
   settings_.max_iterations = options_.max_iterations;
   settings_.function_tolerance = options_.function_tolerance;
   settings_.parameter_tolerance = options_.parameter_tolerance;
@@ -97,7 +111,10 @@ EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::
   }
   const std::size_t n = static_cast<std::size_t>(options_.patch_size_px) * static_cast<std::size_t>(options_.patch_size_px);
   for (Slot& s : slots_) s.patch.assign(n, 0.0f);
-  measured_.assign(n, 0.0f);
+  const int num_parts = std::min(threads, options_.max_features);
+  for (int k = 0; k < num_parts; ++k)
+    parts_.push_back(std::make_unique<Part>(width_, height_, options_.max_features, n));
+  if (num_parts > 1) pool_ = std::make_unique<WorkerPool>(num_parts);
   out_.reserve(1024);
 }
 
@@ -151,26 +168,28 @@ void EkltTracker::activate(int index, const Vec2& uv, TimeNs t_ns, double flow_a
   s.quality = 1.0;
   resetPatch(s);
   // Initial batch size from the template seen along the initial flow.
-  std::fill(measured_.begin(), measured_.end(), 0.0f);
-  const EkltBatch batch{&s.templ, measured_.data(), options_.patch_size_px};
+  Part& part = partOf(index);
+  std::fill(part.measured.begin(), part.measured.end(), 0.0f);
+  const EkltBatch batch{&s.templ, part.measured.data(), options_.patch_size_px};
   EkltEvaluation eval;
   const Vec4 p(s.theta, s.x0.x(), s.x0.y(), s.flow_angle);
   s.batch_size = evaluateEklt(batch, p, false, &eval) ? batchSize(eval.abs_sum) : options_.batch_max_events;
   const PixelRect rect = patchRect(s.centre);
-  grid_.move(index, s.rect, rect);
+  part.grid.move(index, s.rect, rect);
   s.rect = rect;
 }
 
 void EkltTracker::free(int index) {
   Slot& s = slots_[static_cast<std::size_t>(index)];
-  grid_.move(index, s.rect, PixelRect{});
+  partOf(index).grid.move(index, s.rect, PixelRect{});
   s.rect = PixelRect{};
   s.state = Slot::State::kFree;
 }
 
-void EkltTracker::lose(int index) {
+void EkltTracker::lose(Part& part, int index, std::size_t event_index) {
   const Slot& s = slots_[static_cast<std::size_t>(index)];
-  out_.push_back(TrackPoint{s.id, s.t_centre_ns, s.centre, s.quality, TrackStatus::kLost});
+  part.points.push_back(
+      ChunkPoint{event_index, index, TrackPoint{s.id, s.t_centre_ns, s.centre, s.quality, TrackStatus::kLost}});
   free(index);
 }
 
@@ -240,18 +259,42 @@ void EkltTracker::splat(Slot& s, double x, double y, bool positive, TimeNs t_ns)
 }
 
 void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::size_t end) {
+  const auto& x = events.x();
+  const auto& y = events.y();
+  for (std::size_t i = begin; i < end; ++i)
+    if (x[i] >= width_ || y[i] >= height_) throw Error("EkltTracker: event outside the sensor");
+  if (pool_) {
+    auto task = [&](int k) { trackChunk(*parts_[static_cast<std::size_t>(k)], events, begin, end); };
+    pool_->run(task);
+  } else {
+    trackChunk(*parts_.front(), events, begin, end);
+  }
+  timing_.events += end - begin;
+  for (auto& part : parts_) {
+    timing_.events_s += part->timing.events_s;
+    timing_.optimisation_s += part->timing.optimisation_s;
+    timing_.events_in_patches += part->timing.events_in_patches;
+    timing_.optimisations += part->timing.optimisations;
+    timing_.solver_iterations += part->timing.solver_iterations;
+    timing_.reversal_solves += part->timing.reversal_solves;
+    timing_.batches_dropped += part->timing.batches_dropped;
+    part->timing = EkltTiming{};
+  }
+  mergeChunkPoints();
+}
+
+void EkltTracker::trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end) {
   const Stopwatch start;
   const auto& t = events.t();
   const auto& x = events.x();
   const auto& y = events.y();
   const auto& p = events.p();
-  const int words = grid_.words();
+  const int words = part.grid.words();
   std::uint64_t splats = 0;
   for (std::size_t i = begin; i < end; ++i) {
     const int ex = x[i];
     const int ey = y[i];
-    if (ex >= width_ || ey >= height_) throw Error("EkltTracker: event outside the sensor");
-    const std::uint64_t* cell = grid_.at(ex, ey);
+    const std::uint64_t* cell = part.grid.at(ex, ey);
     for (int w = 0; w < words; ++w) {
       std::uint64_t bits = cell[w];  // a copy: optimise() may rewrite the grid
       while (bits != 0) {
@@ -260,17 +303,16 @@ void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::si
         Slot& s = slots_[static_cast<std::size_t>(slot)];
         splat(s, ex, ey, p[i] != 0, t[i]);
         ++splats;
-        if (s.n_events >= s.batch_size) optimise(slot);
+        if (s.n_events >= s.batch_size) optimise(part, slot, i);
       }
     }
   }
-  timing_.events += end - begin;
-  timing_.events_in_patches += splats;
-  timing_.events_s += start.seconds();
+  part.timing.events_in_patches += splats;
+  part.timing.events_s += start.seconds();
 }
 
 std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBatch& batch, const Vec4& p0,
-                                                    const Vec2& predicted) {
+                                                    const Vec2& predicted, EkltTiming& timing) const {
   // A solution is plausible when it moves the feature at most
   // max_batch_shift_px from its prediction: the batch holds the events of
   // about batch_displacement_px of motion (batchSize), so a longer jump is a
@@ -281,8 +323,8 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
   };
   const auto solve = [&](const Vec4& start) {
     EkltSolution sol = solveEklt(solver_, batch, start, settings_);
-    ++timing_.optimisations;
-    timing_.solver_iterations += static_cast<std::uint64_t>(sol.iterations);
+    ++timing.optimisations;
+    timing.solver_iterations += static_cast<std::uint64_t>(sol.iterations);
     return sol;
   };
   EkltSolution sol = solve(p0);
@@ -290,7 +332,7 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
   if (!sol.valid || sol.quality() < options_.reversal_quality || shift(sol) > max_shift) {
     // The motion may have reversed: the increment −∇L·v changed sign, a
     // minimum the optimiser cannot reach from the old φ. Start from φ + π.
-    ++timing_.reversal_solves;
+    ++timing.reversal_solves;
     const EkltSolution reversed = solve(Vec4(p0[0], p0[1], p0[2], p0[3] + M_PI));
     const bool sol_ok = shift(sol) <= max_shift;
     const bool reversed_ok = shift(reversed) <= max_shift;
@@ -300,7 +342,35 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
   return sol;
 }
 
-void EkltTracker::optimise(int index) {
+/// The parts' points of one chunk into out_, in the order one thread
+/// produces them: by event index, then by slot (bits are visited low to high).
+void EkltTracker::mergeChunkPoints() {
+  if (parts_.size() == 1) {
+    for (const ChunkPoint& c : parts_.front()->points) out_.push_back(c.point);
+    parts_.front()->points.clear();
+    return;
+  }
+  std::size_t heads[256] = {};  // threads <= 256 (constructor)
+  while (true) {
+    const ChunkPoint* best = nullptr;
+    std::size_t best_part = 0;
+    for (std::size_t k = 0; k < parts_.size(); ++k) {
+      const auto& pts = parts_[k]->points;
+      if (heads[k] == pts.size()) continue;
+      const ChunkPoint& c = pts[heads[k]];
+      if (!best || c.event < best->event || (c.event == best->event && c.slot < best->slot)) {
+        best = &c;
+        best_part = k;
+      }
+    }
+    if (!best) break;
+    out_.push_back(best->point);
+    ++heads[best_part];
+  }
+  for (auto& part : parts_) part->points.clear();
+}
+
+void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
   const Stopwatch start;
   Slot& s = slots_[static_cast<std::size_t>(index)];
   const TimeNs t_mid = s.t_first_ns + (s.t_last_ns - s.t_first_ns) / 2;
@@ -308,11 +378,12 @@ void EkltTracker::optimise(int index) {
   for (float v : s.patch) norm2 += static_cast<double>(v) * static_cast<double>(v);
   if (!(norm2 > 0.0)) {  // the events cancelled out: nothing to align
     resetPatch(s);
-    timing_.optimisation_s += start.seconds();
+    part.timing.optimisation_s += start.seconds();
     return;
   }
   const float inv = static_cast<float>(1.0 / std::sqrt(norm2));
-  for (std::size_t k = 0; k < s.patch.size(); ++k) measured_[k] = s.patch[k] * inv;
+  std::vector<float>& measured = part.measured;
+  for (std::size_t k = 0; k < s.patch.size(); ++k) measured[k] = s.patch[k] * inv;
 
   // Initial guess: the previous warp, with the centre moved to the gyro
   // prediction when enabled: t = x0 − R(θ)(c_pred − c).
@@ -324,12 +395,12 @@ void EkltTracker::optimise(int index) {
   const double sn = std::sin(s.theta);
   const Vec2 d = predicted - s.centre;
   const Vec4 p0(s.theta, s.x0.x() - (c * d.x() - sn * d.y()), s.x0.y() - (sn * d.x() + c * d.y()), s.flow_angle);
-  const EkltBatch batch{&s.templ, measured_.data(), options_.patch_size_px};
-  const std::optional<EkltSolution> solved = solveBatch(s, batch, p0, predicted);
+  const EkltBatch batch{&s.templ, measured.data(), options_.patch_size_px};
+  const std::optional<EkltSolution> solved = solveBatch(s, batch, p0, predicted, part.timing);
   if (!solved) {  // no solution the batch supports: drop its events, keep the feature where it was
-    ++timing_.batches_dropped;
+    ++part.timing.batches_dropped;
     resetPatch(s);
-    timing_.optimisation_s += start.seconds();
+    part.timing.optimisation_s += start.seconds();
     return;
   }
   const EkltSolution& sol = *solved;
@@ -337,8 +408,8 @@ void EkltTracker::optimise(int index) {
   if (!sol.valid || !uv.allFinite() || sol.quality() < options_.min_tracking_quality ||
       !camera_.isInside(uv, options_.lost_border_px)) {
     if (sol.valid) s.quality = sol.quality();
-    lose(index);
-    timing_.optimisation_s += start.seconds();
+    lose(part, index, event_index);
+    part.timing.optimisation_s += start.seconds();
     return;
   }
   s.theta = sol.p[0];
@@ -355,14 +426,14 @@ void EkltTracker::optimise(int index) {
     point.cov_px = ekltPositionCovariance(at_solution, sol.p, s.x0, options_.patch_size_px,
                                           options_.position_sigma_min_px, options_.position_sigma_max_px);
   }
-  out_.push_back(point);
+  part.points.push_back(ChunkPoint{event_index, index, point});
   resetPatch(s);
   const PixelRect rect = patchRect(uv);
   if (rect.x0 != s.rect.x0 || rect.y0 != s.rect.y0 || rect.x1 != s.rect.x1 || rect.y1 != s.rect.y1) {
-    grid_.move(index, s.rect, rect);
+    part.grid.move(index, s.rect, rect);
     s.rect = rect;
   }
-  timing_.optimisation_s += start.seconds();
+  part.timing.optimisation_s += start.seconds();
 }
 
 void EkltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {

@@ -14,6 +14,7 @@ void FrontendOptions::validate() const {
                "must be eklt, klt or haste (got '" + tracker + "')");
   requireField(image_source == "frames" || image_source == "reconstructed", "image_source",
                "must be frames or reconstructed (got '" + image_source + "')");
+  requireField(threads >= 1 && threads <= 64, "threads", "must be in [1, 64]");
   validateSection("prefilter", prefilter);
   validateSection("eklt", eklt);
   validateSection("klt", klt);
@@ -42,7 +43,7 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
     : options_(options) {
   options_.validate();
   if (options_.tracker == "eklt")
-    tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C);
+    tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C, options_.threads);
   else if (options_.tracker == "haste")
     tracker_ = std::make_unique<HasteTracker>(options_.haste, camera);
   else

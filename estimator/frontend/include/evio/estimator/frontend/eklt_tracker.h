@@ -18,6 +18,14 @@
 ///
 /// Memory is fixed after construction (max_features slots, a per-pixel
 /// feature bitmask); processing an event allocates nothing.
+///
+/// Threads (`threads` > 1): the features are tracked in parallel with a fixed
+/// partition, slot s on part s mod threads (worker_pool.h); each part has its
+/// own pixel bitmask and scratch and walks the whole event chunk for its own
+/// features. A feature's result depends only on its own events, and the
+/// parts' track points are merged in the single-thread order (by event, then
+/// slot), so the output is byte-identical for any thread count. Frames are
+/// handled on the calling thread.
 
 #include <memory>
 #include <optional>
@@ -31,10 +39,12 @@
 #include "evio/estimator/frontend/feature_tracker.h"
 #include "evio/estimator/frontend/gradient_template.h"
 #include "evio/estimator/frontend/gyro_predictor.h"
+#include "evio/estimator/frontend/worker_pool.h"
 
 namespace evio::estimator {
 
-/// Cumulative processing time by stage, seconds of wall time on this thread.
+/// Cumulative processing time by stage, seconds of wall time, summed over the
+/// tracker's threads.
 struct EkltTiming {
   double events_s = 0.0;        ///< addEvents in total (splatting + optimisation)
   double optimisation_s = 0.0;  ///< inside the solver and its bookkeeping
@@ -55,7 +65,9 @@ class EkltTracker final : public FeatureTracker {
  public:
   /// `camera`: the event camera (resolution; projection for the gyro
   /// prediction). `T_B_C` is needed only when options.imu_prediction.
-  EkltTracker(const EkltOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
+  /// `threads` ≥ 1: features tracked in parallel (see the file comment).
+  EkltTracker(const EkltOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt,
+              int threads = 1);
   ~EkltTracker() override;
 
   void addFrame(TimeNs t_ns, const cv::Mat& image) override;
@@ -88,15 +100,27 @@ class EkltTracker final : public FeatureTracker {
 
  private:
   struct Slot;
+  struct Part;
+  /// A track point of an event chunk with what orders it: the index of the
+  /// event that completed the batch, then the slot.
+  struct ChunkPoint {
+    std::size_t event;
+    int slot;
+    TrackPoint point;
+  };
   void splat(Slot& s, double x, double y, bool positive, TimeNs t_ns);
-  void optimise(int slot_index);
+  void trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end);
+  void mergeChunkPoints();
+  void optimise(Part& part, int slot_index, std::size_t event_index);
   /// The batch's solution from p0, re-solved from the reversed flow when
   /// implausible (EkltOptions::reversal_quality, max_batch_shift_px);
-  /// nullopt when neither moves the feature plausibly.
-  std::optional<EkltSolution> solveBatch(const Slot& s, const EkltBatch& batch, const Vec4& p0, const Vec2& predicted);
+  /// nullopt when neither moves the feature plausibly. Counts in `timing`.
+  std::optional<EkltSolution> solveBatch(const Slot& s, const EkltBatch& batch, const Vec4& p0, const Vec2& predicted,
+                                         EkltTiming& timing) const;
   void activate(int slot_index, const Vec2& uv, TimeNs t_ns, double flow_angle);
-  void lose(int slot_index);
+  void lose(Part& part, int slot_index, std::size_t event_index);
   void free(int slot_index);
+  Part& partOf(int slot_index) { return *parts_[static_cast<std::size_t>(slot_index) % parts_.size()]; }
   void resetPatch(Slot& s);
   PixelRect patchRect(const Vec2& centre) const;
   int freeSlot() const;
@@ -112,9 +136,9 @@ class EkltTracker final : public FeatureTracker {
   int half_;                      // h = (P − 1)/2
   int template_radius_;
   std::vector<Slot> slots_;
-  FeatureGrid grid_;
+  std::vector<std::unique_ptr<Part>> parts_;  // slot s belongs to part s mod parts_.size()
+  std::unique_ptr<WorkerPool> pool_;          // null with one thread
   std::unique_ptr<GyroPredictor> predictor_;
-  std::vector<float> measured_;   // normalised batch, P²
   TrackPoints out_;
   FeatureId next_id_ = 0;
   cv::Mat previous_frame8_;

@@ -1,0 +1,62 @@
+#pragma once
+/// @file worker_pool.h
+/// A fixed team of threads for work split into a fixed partition: run(task)
+/// calls task(k) once for every k in [0, size()), part 0 on the calling
+/// thread and part k on worker thread k, and returns when all parts are done.
+/// Which thread runs which part never depends on scheduling, so a caller that
+/// gives each part its own data and merges the parts' results in part order
+/// gets the same result for any number of threads (EkltTracker's features).
+///
+/// The workers sleep on a condition variable between calls (no spinning: the
+/// machine may be shared). An exception thrown by a part is rethrown by run()
+/// after all parts have finished (the first one in part order).
+
+#include <condition_variable>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace evio::estimator {
+
+class WorkerPool {
+ public:
+  /// `size` ≥ 1 parts; size − 1 threads are started.
+  explicit WorkerPool(int size);
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  int size() const { return static_cast<int>(threads_.size()) + 1; }
+
+  /// Calls task(k) for k = 0 … size()−1 (k = 0 here, the others on the
+  /// workers) and waits for all of them. Allocates nothing.
+  template <class Task>
+  void run(Task& task) {
+    runParts(&callTask<Task>, &task);
+  }
+
+ private:
+  using PartFn = void (*)(void* context, int part);
+  template <class Task>
+  static void callTask(void* context, int part) {
+    (*static_cast<Task*>(context))(part);
+  }
+  void runParts(PartFn fn, void* context);
+  void workerLoop(int part);
+  void runPart(int part);
+
+  std::vector<std::thread> threads_;
+  std::mutex mutex_;
+  std::condition_variable start_;
+  std::condition_variable done_;
+  PartFn fn_ = nullptr;
+  void* context_ = nullptr;
+  std::uint64_t generation_ = 0;  // incremented by every run
+  int pending_ = 0;               // worker parts not finished in this run
+  bool stop_ = false;
+  std::vector<std::exception_ptr> errors_;  // per part
+};
+
+}  // namespace evio::estimator

@@ -193,6 +193,160 @@ inline bool warpInside(const GradientTemplate& templ, const WarpFrame& f, int P)
   return cx - r >= lo && cy - r >= lo && cx + r < hi && cy + r < hi;
 }
 
+/// The sums over the patch that evaluateEklt turns into cost, JᵀJ and Jᵀr.
+struct EkltSums {
+  double aa = 0.0, am = 0.0, abs_sum = 0.0;
+  double d[4][4] = {};  // D = Σ ∂a/∂pᵀ ∂a/∂p (upper triangle used)
+  Vec4 da_a = Vec4::Zero();
+  Vec4 da_m = Vec4::Zero();
+};
+
+#if defined(EVIO_EKLT_AVX)
+// evaluateEklt for a warp inside the crop, with the Jacobian, four patch
+// pixels (columns j … j+3 of a row) per 256-bit register. Every lane does the
+// double operations of the one-pixel path (pixelTerm with sampleInside) in
+// the same order, without FMA, so each pixel's a(u) and ∂a/∂p are the same
+// bits; the sums then take the pixels one by one in row-major order, as the
+// one-pixel loop does (each sum's rounding depends on that order), with the
+// ten products of D, and a·∂a/∂p, m·∂a/∂p, as 4-lane vectors of one pixel.
+
+#define EVIO_AVX __attribute__((target("avx"), always_inline)) inline
+
+EVIO_AVX __m256d avxNeg(__m256d x) { return _mm256_xor_pd(x, _mm256_set1_pd(-0.0)); }
+
+/// catmullRomWeights, one fractional position per lane.
+EVIO_AVX void catmullRomWeights4(__m256d t, __m256d w[4], __m256d dw[4]) {
+  const __m256d half = _mm256_set1_pd(0.5);
+#define k(v) _mm256_set1_pd(v)
+  const __m256d t2 = _mm256_mul_pd(t, t);
+  const __m256d t3 = _mm256_mul_pd(t2, t);
+  w[0] = _mm256_mul_pd(half, _mm256_sub_pd(_mm256_add_pd(avxNeg(t3), _mm256_mul_pd(k(2.0), t2)), t));
+  w[1] = _mm256_mul_pd(half, _mm256_add_pd(_mm256_sub_pd(_mm256_mul_pd(k(3.0), t3), _mm256_mul_pd(k(5.0), t2)), k(2.0)));
+  w[2] = _mm256_mul_pd(half, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(k(-3.0), t3), _mm256_mul_pd(k(4.0), t2)), t));
+  w[3] = _mm256_mul_pd(half, _mm256_sub_pd(t3, t2));
+  dw[0] = _mm256_mul_pd(half, _mm256_sub_pd(_mm256_add_pd(_mm256_mul_pd(k(-3.0), t2), _mm256_mul_pd(k(4.0), t)), k(1.0)));
+  dw[1] = _mm256_mul_pd(half, _mm256_sub_pd(_mm256_mul_pd(k(9.0), t2), _mm256_mul_pd(k(10.0), t)));
+  dw[2] = _mm256_mul_pd(half, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(k(-9.0), t2), _mm256_mul_pd(k(8.0), t)), k(1.0)));
+  dw[3] = _mm256_mul_pd(half, _mm256_sub_pd(_mm256_mul_pd(k(3.0), t2), _mm256_mul_pd(k(2.0), t)));
+#undef k
+}
+
+/// One pixel into the sums: a, m and G = ∂a/∂p (also as the array g).
+EVIO_AVX void accumulatePixel(double a, double m, __m256d G, const double* g, EkltSums& s, __m256d D[4],
+                              __m256d& da_a, __m256d& da_m) {
+  s.aa += a * a;
+  s.am += a * m;
+  s.abs_sum += std::abs(a);
+  for (int r = 0; r < 4; ++r) D[r] = _mm256_add_pd(D[r], _mm256_mul_pd(_mm256_set1_pd(g[r]), G));
+  da_a = _mm256_add_pd(da_a, _mm256_mul_pd(_mm256_set1_pd(a), G));
+  da_m = _mm256_add_pd(da_m, _mm256_mul_pd(_mm256_set1_pd(m), G));
+}
+
+/// a(u) and ∂a/∂p of four pixels u = (ux[l], uy): pixelTerm lane by lane.
+struct Terms4 {
+  __m256d a, da[4];
+};
+
+__attribute__((target("avx"))) Terms4 pixelTerms4(const GradientTemplate& templ, const WarpFrame& warp, __m256d ux,
+                                                  __m256d uy) {
+  const __m256d C = _mm256_set1_pd(warp.c), S = _mm256_set1_pd(warp.s);
+  const __m256d Wx =
+      _mm256_add_pd(_mm256_sub_pd(_mm256_mul_pd(C, ux), _mm256_mul_pd(S, uy)), _mm256_set1_pd(warp.t.x()));
+  const __m256d Wy =
+      _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(S, ux), _mm256_mul_pd(C, uy)), _mm256_set1_pd(warp.t.y()));
+  // bicubicTaps: Catmull-Rom weights and the top-left tap of each lane.
+  const __m256d cx = _mm256_sub_pd(Wx, _mm256_set1_pd(static_cast<double>(templ.originX())));
+  const __m256d cy = _mm256_sub_pd(Wy, _mm256_set1_pd(static_cast<double>(templ.originY())));
+  const __m256d fx = _mm256_floor_pd(cx), fy = _mm256_floor_pd(cy);
+  __m256d wx[4], dwx[4], wy[4], dwy[4];
+  catmullRomWeights4(_mm256_sub_pd(cx, fx), wx, dwx);
+  catmullRomWeights4(_mm256_sub_pd(cy, fy), wy, dwy);
+  alignas(16) int ix[4], iy[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(ix), _mm256_cvttpd_epi32(fx));
+  _mm_store_si128(reinterpret_cast<__m128i*>(iy), _mm256_cvttpd_epi32(fy));
+  const int n = templ.size();
+  const float* base[4];
+  for (int l = 0; l < 4; ++l) base[l] = templ.data() + 2 * ((iy[l] - 1) * n + ix[l] - 1);
+  const __m256d zero = _mm256_setzero_pd();
+  __m256d f[2] = {zero, zero}, fdx[2] = {zero, zero}, fdy[2] = {zero, zero};  // channel gx, gy
+  for (int i = 0; i < 4; ++i) {
+    // Row i of the taps of the four lanes, (gx, gy) of taps 0–1 and 2–3,
+    // transposed to one register per (tap, channel) with a lane per pixel.
+    __m128 lo[4], hi[4];
+    for (int l = 0; l < 4; ++l) {
+      const __m256 row = _mm256_loadu_ps(base[l] + 2 * i * n);
+      lo[l] = _mm256_castps256_ps128(row);
+      hi[l] = _mm256_extractf128_ps(row, 1);
+    }
+    _MM_TRANSPOSE4_PS(lo[0], lo[1], lo[2], lo[3]);  // gx0, gy0, gx1, gy1
+    _MM_TRANSPOSE4_PS(hi[0], hi[1], hi[2], hi[3]);  // gx2, gy2, gx3, gy3
+    const __m128 taps[4][2] = {{lo[0], lo[1]}, {lo[2], lo[3]}, {hi[0], hi[1]}, {hi[2], hi[3]}};
+    for (int k = 0; k < 2; ++k) {
+      __m256d r = zero, d = zero;
+      for (int j = 0; j < 4; ++j) {
+        const __m256d v = _mm256_cvtps_pd(taps[j][k]);
+        r = _mm256_add_pd(r, _mm256_mul_pd(wx[j], v));
+        d = _mm256_add_pd(d, _mm256_mul_pd(dwx[j], v));
+      }
+      f[k] = _mm256_add_pd(f[k], _mm256_mul_pd(wy[i], r));
+      fdx[k] = _mm256_add_pd(fdx[k], _mm256_mul_pd(wy[i], d));
+      fdy[k] = _mm256_add_pd(fdy[k], _mm256_mul_pd(dwy[i], r));
+    }
+  }
+  // pixelTerm: a = −g·w, b = −(∂g/∂W)ᵀ w, ∂a/∂p.
+  const __m256d w0 = _mm256_set1_pd(warp.w.x()), w1 = _mm256_set1_pd(warp.w.y());
+  const __m256d wp0 = _mm256_set1_pd(warp.w_perp.x()), wp1 = _mm256_set1_pd(warp.w_perp.y());
+  Terms4 t;
+  t.a = avxNeg(_mm256_add_pd(_mm256_mul_pd(f[0], w0), _mm256_mul_pd(f[1], w1)));
+  const __m256d b0 = avxNeg(_mm256_add_pd(_mm256_mul_pd(fdx[0], w0), _mm256_mul_pd(fdx[1], w1)));
+  const __m256d b1 = avxNeg(_mm256_add_pd(_mm256_mul_pd(fdy[0], w0), _mm256_mul_pd(fdy[1], w1)));
+  const __m256d dW0 = _mm256_sub_pd(_mm256_mul_pd(avxNeg(S), ux), _mm256_mul_pd(C, uy));
+  const __m256d dW1 = _mm256_sub_pd(_mm256_mul_pd(C, ux), _mm256_mul_pd(S, uy));
+  const __m256d g_wp = _mm256_add_pd(_mm256_mul_pd(f[0], wp0), _mm256_mul_pd(f[1], wp1));
+  t.da[0] = _mm256_sub_pd(_mm256_add_pd(_mm256_mul_pd(b0, dW0), _mm256_mul_pd(b1, dW1)), g_wp);
+  t.da[1] = b0;
+  t.da[2] = b1;
+  t.da[3] = avxNeg(g_wp);
+  return t;
+}
+
+__attribute__((target("avx"))) void sumPatchAvx(const EkltBatch& batch, const WarpFrame& frame, EkltSums* sums) {
+  const int P = batch.patch_size;
+  const double h = 0.5 * (P - 1);
+  const __m256d zero = _mm256_setzero_pd();
+  __m256d D[4] = {zero, zero, zero, zero};
+  __m256d da_a = zero, da_m = zero;
+  EkltSums& s = *sums;
+  for (int i = 0; i < P; ++i) {
+    const double uy = i - h;
+    const float* m_row = batch.measured + static_cast<std::ptrdiff_t>(i) * P;
+    // Groups of four columns; the last group is aligned to the row's end and
+    // overlaps the one before (P ≥ 4 and P not a multiple of 4): its lanes
+    // already summed are skipped, so every pixel is summed once, in order.
+    for (int j = 0; j < P; j += 4) {
+      const int j0 = std::min(j, P - 4);
+      const __m256d ux = _mm256_setr_pd(j0 - h, (j0 + 1) - h, (j0 + 2) - h, (j0 + 3) - h);
+      const Terms4 t = pixelTerms4(*batch.templ, frame, ux, _mm256_set1_pd(uy));
+      // Lanes to pixels: a, m and the 4×4 transpose of ∂a/∂p.
+      alignas(32) double a[4], g[4][4];
+      _mm256_store_pd(a, t.a);
+      const __m256d t0 = _mm256_unpacklo_pd(t.da[0], t.da[1]), t1 = _mm256_unpackhi_pd(t.da[0], t.da[1]);
+      const __m256d t2 = _mm256_unpacklo_pd(t.da[2], t.da[3]), t3 = _mm256_unpackhi_pd(t.da[2], t.da[3]);
+      const __m256d G[4] = {_mm256_permute2f128_pd(t0, t2, 0x20), _mm256_permute2f128_pd(t1, t3, 0x20),
+                            _mm256_permute2f128_pd(t0, t2, 0x31), _mm256_permute2f128_pd(t1, t3, 0x31)};
+      for (int l = 0; l < 4; ++l) _mm256_store_pd(g[l], G[l]);
+      for (int l = j - j0; l < 4; ++l)
+        accumulatePixel(a[l], static_cast<double>(m_row[j0 + l]), G[l], g[l], s, D, da_a, da_m);
+    }
+  }
+  for (int r = 0; r < 4; ++r) _mm256_storeu_pd(s.d[r], D[r]);
+  _mm256_storeu_pd(s.da_a.data(), da_a);
+  _mm256_storeu_pd(s.da_m.data(), da_m);
+}
+
+#undef EVIO_AVX
+#endif
+
 }  // namespace
 
 namespace detail {
@@ -202,12 +356,13 @@ void ekltSampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat
 }
 }  // namespace detail
 
-bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out) {
+namespace {
+
+/// The one-pixel loop over the patch (any warp; with or without the Jacobian).
+void sumPatch(const EkltBatch& batch, const WarpFrame& frame, bool with_jacobian, bool inside, bool avx,
+              EkltSums* sums) {
   const int P = batch.patch_size;
   const double h = 0.5 * (P - 1);
-  const WarpFrame frame(p);
-  const bool inside = warpInside(*batch.templ, frame, P);
-  const bool avx = cpuHasAvx();
   double aa = 0.0, am = 0.0, abs_sum = 0.0;
   // Upper triangle of D = Σ ∂a/∂pᵀ ∂a/∂p, accumulated by hand (10 terms).
   double d00 = 0, d01 = 0, d02 = 0, d03 = 0, d11 = 0, d12 = 0, d13 = 0, d22 = 0, d23 = 0, d33 = 0;
@@ -239,20 +394,45 @@ bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, Ekl
       }
     }
   }
+  EkltSums& s = *sums;
+  s.aa = aa;
+  s.am = am;
+  s.abs_sum = abs_sum;
+  const double upper[4][4] = {{d00, d01, d02, d03}, {0, d11, d12, d13}, {0, 0, d22, d23}, {0, 0, 0, d33}};
+  for (int r = 0; r < 4; ++r)
+    for (int c = r; c < 4; ++c) s.d[r][c] = upper[r][c];
+  s.da_a = da_a;
+  s.da_m = da_m;
+}
+
+}  // namespace
+
+bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out) {
+  const WarpFrame frame(p);
+  const bool inside = warpInside(*batch.templ, frame, batch.patch_size);
+  const bool avx = cpuHasAvx();
+  EkltSums s;
+#if defined(EVIO_EKLT_AVX)
+  if (inside && avx && with_jacobian && batch.patch_size >= 4)
+    sumPatchAvx(batch, frame, &s);
+  else
+#endif
+    sumPatch(batch, frame, with_jacobian, inside, avx, &s);
+  const double aa = s.aa;
   if (!(aa > 0.0) || !std::isfinite(aa)) return false;
   const double n = std::sqrt(aa);
-  out->rho = am / n;
+  out->rho = s.am / n;
   out->cost = 1.0 - out->rho;  // ½(‖â‖² − 2âᵀm + ‖m‖²) with unit norms
-  out->abs_sum = abs_sum;
+  out->abs_sum = s.abs_sum;
   if (with_jacobian) {
     Mat4 Dfull;
-    Dfull << d00, d01, d02, d03,  //
-        d01, d11, d12, d13,       //
-        d02, d12, d22, d23,       //
-        d03, d13, d23, d33;
-    const Vec4 s = da_a / n;
-    out->jtj = (Dfull - s * s.transpose()) / aa;
-    out->jtr = (out->rho * s - da_m) / n;
+    Dfull << s.d[0][0], s.d[0][1], s.d[0][2], s.d[0][3],  //
+        s.d[0][1], s.d[1][1], s.d[1][2], s.d[1][3],        //
+        s.d[0][2], s.d[1][2], s.d[2][2], s.d[2][3],        //
+        s.d[0][3], s.d[1][3], s.d[2][3], s.d[3][3];
+    const Vec4 sv = s.da_a / n;
+    out->jtj = (Dfull - sv * sv.transpose()) / aa;
+    out->jtr = (out->rho * sv - s.da_m) / n;
   }
   return true;
 }

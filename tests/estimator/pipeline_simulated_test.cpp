@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "evio/core/io/atomic_file.h"
@@ -87,26 +88,35 @@ TEST_F(PipelineSimulated, EkltVio) {
   runAndCheck(o, "eklt", 60);  // an update every 3200 events: more than one per frame
 }
 
-// Features tracked on 1, 2 or 3 threads (frontend.threads): the estimate
-// files are the same bytes (eklt_tracker.h: fixed partition, merge in the
-// single-thread order).
+// Features tracked on 1, 2 or 3 threads (frontend.threads), the backend on
+// the reading thread or its own (backend_thread): the estimate files and the
+// counts are the same bytes (eklt_tracker.h: fixed partition, merge in the
+// single-thread order; pipeline.cpp: items handed to the backend in order).
 TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCount) {
   std::vector<std::string> outs;
-  for (int threads : {1, 2, 3}) {
+  std::vector<PipelineCounts> counts;
+  const std::pair<int, bool> configs[] = {{1, false}, {2, false}, {3, false}, {1, true}, {2, true}};
+  for (const auto& [threads, backend_thread] : configs) {
     PipelineOptions o = fromGroundTruth("eklt-vio");
     o.frontend.threads = threads;
+    o.backend_thread = backend_thread;
     o.frontend.eklt.position_covariance = true;
-    outs.push_back(dir_->file("eklt_threads_" + std::to_string(threads)));
+    outs.push_back(dir_->file("eklt_threads_" + std::to_string(threads) + (backend_thread ? "_bt" : "")));
     const PipelineResult r = runPipeline(sequence(), o, outs.back());
     ASSERT_TRUE(r.status.ok()) << r.status.cause;
     ASSERT_GT(r.counts.measurement_sets, 60u);
+    counts.push_back(r.counts);
   }
-  for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt"}) {
-    const std::string one = io::readFile(outs[0] + "/" + file);
-    EXPECT_FALSE(one.empty()) << file;
-    for (std::size_t k = 1; k < outs.size(); ++k)
-      EXPECT_TRUE(one == io::readFile(outs[k] + "/" + file)) << file << ", " << k + 1 << " threads";
+  for (std::size_t k = 1; k < outs.size(); ++k) {
+    const std::string config = std::to_string(configs[k].first) + " threads" + (configs[k].second ? " + backend thread" : "");
+    for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
+      EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[k] + "/" + file)) << file << ", " << config;
+    EXPECT_EQ(counts[0].events, counts[k].events) << config;
+    EXPECT_EQ(counts[0].track_points, counts[k].track_points) << config;
+    EXPECT_EQ(counts[0].measurement_sets, counts[k].measurement_sets) << config;
+    EXPECT_EQ(counts[0].poses, counts[k].poses) << config;
   }
+  EXPECT_FALSE(io::readFile(outs[0] + "/trajectory.txt").empty());
 }
 
 TEST_F(PipelineSimulated, KltVio) { runAndCheck(fromGroundTruth("klt-vio"), "klt", 40); }

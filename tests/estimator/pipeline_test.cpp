@@ -213,6 +213,36 @@ TEST(PipelineBadInput, ImuEndingWhileFramesContinueFails) {
   EXPECT_NE(r.status.cause.find("no IMU reading after"), std::string::npos) << r.status.cause;
 }
 
+// The backend on its own thread (backend_thread) stops at the same item when
+// the run fails: the same status, files and counts as on one thread, though
+// the reading side ran ahead.
+TEST(PipelineBadInput, BackendThreadFailsAtTheSameItemAsOneThread) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 4.0;
+  so.frames = 80;
+  so.imu_gaps_s = {{1.5, 3.0}};
+  writeTinySequence(seq, so);
+  for (const char* method : {"tracks", "klt-vio"}) {
+    PipelineOptions one = std::string(method) == "tracks" ? tracksOptions() : fromGroundTruth(method);
+    PipelineOptions two = one;
+    two.backend_thread = true;
+    const PipelineResult r1 = runPipeline(seq, one, dir.file(std::string(method) + "_1"));
+    const PipelineResult r2 = runPipeline(seq, two, dir.file(std::string(method) + "_2"));
+    EXPECT_EQ(r1.status.code, io::EstimateStatus::Code::kFailed) << method;
+    EXPECT_EQ(r1.status, r2.status) << method;
+    EXPECT_EQ(r1.t_last_ns, r2.t_last_ns) << method;
+    EXPECT_EQ(r1.counts.imu_samples, r2.counts.imu_samples) << method;
+    EXPECT_EQ(r1.counts.frames, r2.counts.frames) << method;
+    EXPECT_EQ(r1.counts.measurement_sets, r2.counts.measurement_sets) << method;
+    for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "status.yaml"})
+      EXPECT_EQ(io::readFile(dir.file(std::string(method) + "_1/" + file)),
+                io::readFile(dir.file(std::string(method) + "_2/" + file)))
+          << method << " " << file;
+  }
+}
+
 // --- other bad input: one clear evio::Error ------------------------------------------------------
 
 TEST(PipelineBadInput, EventsOutOfOrderNameTheFileAndLine) {
@@ -226,6 +256,11 @@ TEST(PipelineBadInput, EventsOutOfOrderNameTheFileAndLine) {
   expectErrorContaining([&] { runPipeline(seq, fromGroundTruth("eklt-vio"), dir.file("out")); },
                         {"events.txt:3"});
   EXPECT_FALSE(fs::exists(dir.file("out/trajectory.txt")));  // nothing half-written
+  PipelineOptions threaded = fromGroundTruth("eklt-vio");
+  threaded.backend_thread = true;
+  threaded.frontend.threads = 2;
+  expectErrorContaining([&] { runPipeline(seq, threaded, dir.file("out2")); }, {"events.txt:3"});
+  EXPECT_FALSE(fs::exists(dir.file("out2/trajectory.txt")));
 }
 
 TEST(PipelineBadInput, NoFramesForFrameBasedTrackingSaysWhatToDo) {

@@ -270,6 +270,7 @@ void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::si
     trackChunk(*parts_.front(), events, begin, end);
   }
   timing_.events += end - begin;
+  if (pool_) timing_.worker_cpu_s = pool_->workerCpuSeconds();
   for (auto& part : parts_) {
     timing_.events_s += part->timing.events_s;
     timing_.optimisation_s += part->timing.optimisation_s;

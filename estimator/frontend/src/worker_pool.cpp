@@ -1,6 +1,7 @@
 #include "evio/estimator/frontend/worker_pool.h"
 
 #include "evio/core/error.h"
+#include "evio/core/stopwatch.h"
 
 namespace evio::estimator {
 
@@ -59,10 +60,13 @@ void WorkerPool::workerLoop(int part) {
       if (stop_) return;
       seen = generation_;
     }
+    const double cpu0 = Stopwatch::threadCpuSeconds();
     runPart(part);
+    const double cpu = Stopwatch::threadCpuSeconds() - cpu0;
     bool last = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      worker_cpu_s_ += cpu;
       last = --pending_ == 0;
     }
     if (last) done_.notify_one();

@@ -1,8 +1,10 @@
 #include "evio/estimator/pipeline/pipeline.h"
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "evio/core/error.h"
 #include "evio/core/stopwatch.h"
@@ -12,6 +14,7 @@
 #include "evio/estimator/pipeline/method.h"
 #include "evio/estimator/pipeline/sequence_rig.h"
 #include "evio/estimator/pipeline/stages.h"
+#include "handoff_queue.h"
 
 namespace evio::estimator {
 
@@ -32,19 +35,37 @@ class StageTimer {
   Stopwatch watch_;
 };
 
-/// Process CPU time between successive laps: lap(&acc) adds the CPU seconds
-/// since the previous lap (or construction) to acc.
+/// CPU time of the calling thread between successive laps: lap(&acc) adds
+/// the CPU seconds since the previous lap (or construction) to acc.
 class CpuLap {
  public:
-  CpuLap() : last_(Stopwatch::processCpuSecondsPrecise()) {}
+  CpuLap() : last_(Stopwatch::threadCpuSeconds()) {}
   void lap(double* acc) {
-    const double now = Stopwatch::processCpuSecondsPrecise();
+    const double now = Stopwatch::threadCpuSeconds();
     *acc += now - last_;
     last_ = now;
   }
 
  private:
   double last_;
+};
+
+/// Where the reading side stood after an item: what the backend side needs
+/// to check health, write timing and progress, and the counts of the run if
+/// it ends there.
+struct ItemSnapshot {
+  TimeNs t_now = 0;  // data time reached (camera clock)
+  std::uint64_t events_read = 0;
+  double fraction = 0.0;
+  bool have_imu = false;
+  TimeNs last_imu_cam = 0;
+  PipelineCounts counts;  // events, events_kept, frames, track_points, imu_samples
+};
+
+/// The backend's share of one item: its inputs, and the snapshot after it.
+struct BackendWork {
+  std::vector<BackendInput> inputs;
+  ItemSnapshot snapshot;
 };
 
 /// One run of the pipeline; see pipeline.h. setup() builds the stages once;
@@ -70,9 +91,11 @@ class PipelineRun {
   void setupReader(const std::vector<io::ImageStamp>& images);
   void setupStages();
   void loop();
-  void runStages(SequenceItem& item);
-  void afterItem(TimeNs t_ns);
-  void writeTiming(TimeNs t_ns);
+  void runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs);
+  void takeSnapshot(ItemSnapshot& snapshot) const;
+  void consume(BackendWork& work);
+  void afterItem(const ItemSnapshot& snapshot);
+  void writeTiming(TimeNs t_ns, std::uint64_t events_read);
   void finish();
   io::EstimateStatus finalStatus() const;
   /// Processing time since the loop started on the clock of output.timing_clock.
@@ -106,7 +129,7 @@ class PipelineRun {
   // Each stage's outputs, reused from item to item.
   std::vector<SequenceItem> filtered_;
   std::vector<FrontendOutput> tracked_;
-  std::vector<BackendInput> backend_inputs_;
+  BackendWork inline_work_;  // without a backend thread
   std::vector<Estimate> estimates_;
   std::vector<Estimate> checked_;
 
@@ -123,6 +146,9 @@ class PipelineRun {
   TimeNs t_now_ = 0;
   bool any_item_ = false;
   std::optional<io::EstimateStatus> pipeline_failure_;
+  // Backend side (the backend thread when options.backend_thread)
+  std::atomic<bool> stopped_{false};  // diverged or failed with stop_on_divergence: no more input
+  ItemSnapshot last_consumed_;        // the last item the backend side took
 };
 
 void PipelineRun::setup() {
@@ -222,31 +248,51 @@ void PipelineRun::setupStages() {
   health_ = std::make_unique<HealthMonitor>(options_.health);
 }
 
-void PipelineRun::runStages(SequenceItem& item) {
+void PipelineRun::runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs) {
   PipelineStageCpu& cpu = result_.cpu;
   CpuLap lap;
-  backend_inputs_.clear();
-  {
-    StageTimer timer(&result_.times.frontend_s);
-    if (tracks_) {
-      tracks_->process(item, backend_inputs_);
-      lap.lap(&cpu.sync_s);
-    } else {
-      filtered_.clear();
-      tracked_.clear();
-      prefilter_->process(item, filtered_);
-      lap.lap(&cpu.prefilter_s);
-      for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
-      lap.lap(&cpu.tracking_s);
-      for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs_);
-      lap.lap(&cpu.sync_s);
-      if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
-    }
+  StageTimer timer(&result_.times.frontend_s);
+  if (tracks_) {
+    tracks_->process(item, backend_inputs);
+    lap.lap(&cpu.sync_s);
+    return;
   }
+  filtered_.clear();
+  tracked_.clear();
+  prefilter_->process(item, filtered_);
+  lap.lap(&cpu.prefilter_s);
+  for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
+  lap.lap(&cpu.tracking_s);
+  for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs);
+  lap.lap(&cpu.sync_s);
+  if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
+}
+
+void PipelineRun::takeSnapshot(ItemSnapshot& s) const {
+  s.t_now = t_now_;
+  s.events_read = reader_->eventsRead();
+  s.fraction = reader_->fraction();
+  s.have_imu = have_imu_;
+  s.last_imu_cam = last_imu_cam_;
+  s.counts.imu_samples = result_.counts.imu_samples;
+  if (prefilter_) {
+    s.counts.events = prefilter_->numEventsSeen();
+    s.counts.events_kept = prefilter_->numEventsKept();
+    s.counts.frames = frontend_->numFrames();
+    s.counts.track_points = sync_->numTrackPoints();
+  }
+}
+
+/// The backend side of one item: backend, health monitor, writer, then the
+/// run's health checks, timing and progress. Nothing once stopped.
+void PipelineRun::consume(BackendWork& work) {
+  if (stopped_.load(std::memory_order_relaxed)) return;
+  PipelineStageCpu& cpu = result_.cpu;
+  CpuLap lap;
   estimates_.clear();
   {
     StageTimer timer(&result_.times.backend_s);
-    for (BackendInput& in : backend_inputs_) backend_stage_->process(in, estimates_);
+    for (BackendInput& in : work.inputs) backend_stage_->process(in, estimates_);
   }
   lap.lap(&cpu.backend_s);
   checked_.clear();
@@ -255,35 +301,39 @@ void PipelineRun::runStages(SequenceItem& item) {
     StageTimer timer(&result_.times.output_s);
     for (const Estimate& e : checked_) writer_->addEstimate(e);
   }
+  afterItem(work.snapshot);
   lap.lap(&cpu.output_s);
+  last_consumed_ = work.snapshot;
+  const bool stop = !backend_->status().ok() || pipeline_failure_.has_value();
+  if (stop && options_.output.stop_on_divergence) stopped_.store(true);
 }
 
-void PipelineRun::afterItem(TimeNs t_ns) {
+void PipelineRun::afterItem(const ItemSnapshot& snapshot) {
+  const TimeNs t_ns = snapshot.t_now;
   if (backend_->initialized() && !result_.initialization_t_ns)
     result_.initialization_t_ns = backend_->state().imu.t_ns - offset_ns_;
   // The IMU must keep up with the other streams: a run of data without IMU
   // longer than imu_fail_gap_s after initialisation fails like a gap.
-  if (backend_->initialized() && backend_->status().ok() && have_imu_ && !pipeline_failure_ &&
-      nsToSeconds(t_ns - last_imu_cam_) > options_.backend.imu_fail_gap_s) {
+  if (backend_->initialized() && backend_->status().ok() && snapshot.have_imu && !pipeline_failure_ &&
+      nsToSeconds(t_ns - snapshot.last_imu_cam) > options_.backend.imu_fail_gap_s) {
     io::EstimateStatus s;
     s.code = io::EstimateStatus::Code::kFailed;
-    s.t_ns = last_imu_cam_;
-    s.cause = "no IMU reading after " + secondsText(last_imu_cam_) + " while data continue (gap above " +
+    s.t_ns = snapshot.last_imu_cam;
+    s.cause = "no IMU reading after " + secondsText(snapshot.last_imu_cam) + " while data continue (gap above " +
               "backend.imu_fail_gap_s)";
     pipeline_failure_ = s;
   }
-  if (result_.initialization_t_ns) writeTiming(t_ns);
-  if (progress_)
-    progress_(PipelineProgress{reader_->fraction(), t_ns, reader_->eventsRead(), backend_->initialized()});
+  if (result_.initialization_t_ns) writeTiming(t_ns, snapshot.events_read);
+  if (progress_) progress_(PipelineProgress{snapshot.fraction, t_ns, snapshot.events_read, backend_->initialized()});
 }
 
-void PipelineRun::writeTiming(TimeNs t_ns) {
+void PipelineRun::writeTiming(TimeNs t_ns, std::uint64_t events_read) {
   const double processing = elapsed();
   if (timing_started_ && !(t_ns > last_timing_t_ && nsToSeconds(t_ns - last_timing_t_) >= options_.output.timing_interval_s))
     return;
   const TimeNs t = timing_started_ ? t_ns : std::max(t_ns, *result_.initialization_t_ns);
   if (timing_started_ && t <= last_timing_t_) return;
-  writer_->addTiming(io::TimingSample{t, processing, static_cast<std::int64_t>(reader_->eventsRead())});
+  writer_->addTiming(io::TimingSample{t, processing, static_cast<std::int64_t>(events_read)});
   timing_started_ = true;
   last_timing_t_ = t;
 }
@@ -292,8 +342,11 @@ void PipelineRun::loop() {
   loop_watch_.restart();
   loop_start_cpu_s_ = Stopwatch::processCpuSeconds();
   cpu_clock_ = options_.output.timing_clock == "cpu";
+  // With a backend thread, items wait in a ring of 64 between the two sides.
+  std::optional<HandoffQueue<BackendWork>> handoff;
+  if (options_.backend_thread) handoff.emplace(64, [this](BackendWork& w) { consume(w); });
   SequenceItem item;
-  while (true) {
+  while (!stopped_.load() && !(handoff && handoff->failed())) {
     {
       StageTimer timer(&result_.times.read_s);
       CpuLap lap;
@@ -313,18 +366,27 @@ void PipelineRun::loop() {
       have_imu_ = true;
       last_imu_cam_ = item.t_ns;
     }
-    runStages(item);
-    afterItem(t_now_);
-    const bool stopped = !backend_->status().ok() || pipeline_failure_.has_value();
-    if (stopped && options_.output.stop_on_divergence) break;
+    BackendWork& work = handoff ? handoff->slot() : inline_work_;
+    work.inputs.clear();
+    runFrontStages(item, work.inputs);
+    takeSnapshot(work.snapshot);
+    if (handoff)
+      handoff->push();
+    else
+      consume(work);
   }
-  result_.t_last_ns = t_now_;
+  if (handoff) handoff->finish();
+  // The run ends at the last item the backend side took (the same item
+  // whether or not it ran on its own thread).
+  result_.t_last_ns = last_consumed_.t_now;
+  result_.counts.imu_samples = last_consumed_.counts.imu_samples;
   if (prefilter_) {
-    result_.counts.events = prefilter_->numEventsSeen();
-    result_.counts.events_kept = prefilter_->numEventsKept();
-    result_.counts.frames = frontend_->numFrames();
-    result_.counts.track_points = sync_->numTrackPoints();
+    result_.counts.events = last_consumed_.counts.events;
+    result_.counts.events_kept = last_consumed_.counts.events_kept;
+    result_.counts.frames = last_consumed_.counts.frames;
+    result_.counts.track_points = last_consumed_.counts.track_points;
     if (const EkltTiming* t = frontend_->ekltTiming()) {
+      result_.cpu.tracking_s += t->worker_cpu_s;
       result_.cpu.eklt_optimisation_s = t->optimisation_s;
       result_.cpu.eklt_events_s = t->splattingS();
       result_.cpu.eklt_frames_s = t->frame_s;
@@ -349,7 +411,7 @@ io::EstimateStatus PipelineRun::finalStatus() const {
     status.cause = v.cause;
   } else if (!backend_->initialized()) {
     status.code = io::EstimateStatus::Code::kFailed;
-    status.t_ns = t_now_;
+    status.t_ns = last_consumed_.t_now;
     status.cause = options_.init.mode == "static"
                        ? "never initialised: no still IMU window of backend.static_window_s"
                        : "never initialised: no IMU reading at or after the initialisation time";
@@ -359,8 +421,9 @@ io::EstimateStatus PipelineRun::finalStatus() const {
 }
 
 void PipelineRun::finish() {
-  if (timing_started_ && t_now_ > last_timing_t_)
-    writer_->addTiming(io::TimingSample{t_now_, elapsed(), static_cast<std::int64_t>(reader_->eventsRead())});
+  if (timing_started_ && last_consumed_.t_now > last_timing_t_)
+    writer_->addTiming(io::TimingSample{last_consumed_.t_now, elapsed(),
+                                        static_cast<std::int64_t>(last_consumed_.events_read)});
   result_.backend = backend_->stats();
   result_.counts.poses = writer_->numPoses();
   result_.status = finalStatus();

@@ -57,6 +57,7 @@ struct EkltTiming {
   std::uint64_t solver_iterations = 0;
   std::uint64_t reversal_solves = 0;  ///< second solves from φ + π (EkltOptions::reversal_quality)
   std::uint64_t batches_dropped = 0;  ///< batches without a plausible solution (max_batch_shift_px)
+  double worker_cpu_s = 0.0;  ///< CPU seconds of the worker threads (threads > 1; the caller's thread excluded)
   /// Splatting and lookup: events_s − optimisation_s.
   double splattingS() const { return events_s - optimisation_s; }
 };

@@ -30,6 +30,13 @@ class WorkerPool {
 
   int size() const { return static_cast<int>(threads_.size()) + 1; }
 
+  /// CPU seconds the worker threads spent in their parts so far (thread CPU
+  /// clock; part 0 runs on the caller's thread and is not included).
+  double workerCpuSeconds() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return worker_cpu_s_;
+  }
+
   /// Calls task(k) for k = 0 … size()−1 (k = 0 here, the others on the
   /// workers) and waits for all of them. Allocates nothing.
   template <class Task>
@@ -48,7 +55,7 @@ class WorkerPool {
   void runPart(int part);
 
   std::vector<std::thread> threads_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable start_;
   std::condition_variable done_;
   PartFn fn_ = nullptr;
@@ -56,6 +63,7 @@ class WorkerPool {
   std::uint64_t generation_ = 0;  // incremented by every run
   int pending_ = 0;               // worker parts not finished in this run
   bool stop_ = false;
+  double worker_cpu_s_ = 0.0;
   std::vector<std::exception_ptr> errors_;  // per part
 };
 

@@ -81,10 +81,10 @@ struct PipelineStageTimes {
   }
 };
 
-/// CPU seconds per stage (process CPU clock, so the tracker's worker threads
-/// count with the tracking stage), summed over the run; read once per stage
-/// and input item (a chunk of events, a frame, an IMU sample), never per
-/// event. The `eklt_*` entries split EKLT's tracking time as the tracker
+/// CPU seconds per stage (the CPU clock of the thread that ran the stage;
+/// tracking includes the tracker's worker threads), summed over the run;
+/// read once per stage and input item (a chunk of events, a frame, an IMU
+/// sample), never per event. The `eklt_*` entries split EKLT's tracking time as the tracker
 /// itself measures it (wall seconds summed over its threads; 0 for the other
 /// trackers).
 struct PipelineStageCpu {
@@ -93,7 +93,7 @@ struct PipelineStageCpu {
   double tracking_s = 0.0;   ///< the frontend: reconstruction and tracker
   double sync_s = 0.0;       ///< synchroniser (tracks_ method: reading the tracks)
   double backend_s = 0.0;    ///< EKF propagation and updates
-  double output_s = 0.0;     ///< health monitor and writing the estimate files
+  double output_s = 0.0;     ///< health monitor, writing the estimate files, timing and progress
   double eklt_optimisation_s = 0.0;  ///< EKLT: the per-batch optimisations
   double eklt_events_s = 0.0;        ///< EKLT: event lookup and splatting (events minus optimisation)
   double eklt_frames_s = 0.0;        ///< EKLT: frames (log image, gradients, templates, detection, bootstrap)

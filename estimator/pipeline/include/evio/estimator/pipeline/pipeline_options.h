@@ -153,6 +153,10 @@ struct PipelineOptions {
   TracksInputOptions tracks;
   HealthOptions health;
   PipelineOutputOptions output;
+  /// Run the backend, the health monitor and the writer on a thread of their
+  /// own, overlapped with reading and tracking (items handed over in order
+  /// through a ring of 64): the same output files, byte for byte.
+  bool backend_thread = false;
 
   template <class V>
   void fields(V& v) {
@@ -166,6 +170,7 @@ struct PipelineOptions {
     v("tracks", tracks, "tracks input (method tracks)");
     v("health", health, "self-diagnosis without ground truth");
     v("output", output, "outputs");
+    v("backend_thread", backend_thread, "backend, health monitor and writer on their own thread (same output)");
   }
   /// Throws evio::Error naming the field (nested fields with their path,
   /// e.g. "frontend.tracker: must be klt for method klt-vio").

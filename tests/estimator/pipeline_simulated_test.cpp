@@ -119,6 +119,22 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCount) {
   EXPECT_FALSE(io::readFile(outs[0] + "/trajectory.txt").empty());
 }
 
+// HASTE-VIO alike: 1 thread against 2 tracker threads and the backend thread.
+TEST_F(PipelineSimulated, HasteVioEstimatesAreByteIdenticalForAnyThreadCount) {
+  std::vector<std::string> outs;
+  for (int threads : {1, 2}) {
+    PipelineOptions o = fromGroundTruth("haste-vio");
+    o.frontend.threads = threads;
+    o.backend_thread = threads > 1;
+    outs.push_back(dir_->file("haste_threads_" + std::to_string(threads)));
+    const PipelineResult r = runPipeline(sequence(), o, outs.back());
+    ASSERT_TRUE(r.status.ok()) << r.status.cause;
+    ASSERT_GT(r.counts.measurement_sets, 30u);
+  }
+  for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
+    EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[1] + "/" + file)) << file;
+}
+
 TEST_F(PipelineSimulated, KltVio) { runAndCheck(fromGroundTruth("klt-vio"), "klt", 40); }
 
 TEST_F(PipelineSimulated, BackendOnNoisyGroundTruthTracks) {

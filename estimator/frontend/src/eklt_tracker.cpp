@@ -114,6 +114,7 @@ EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::
   const int num_parts = std::min(threads, options_.max_features);
   for (int k = 0; k < num_parts; ++k)
     parts_.push_back(std::make_unique<Part>(width_, height_, options_.max_features, n));
+  for (auto& part : parts_) part_points_.push_back(&part->points);
   if (num_parts > 1) pool_ = std::make_unique<WorkerPool>(num_parts);
   out_.reserve(1024);
 }
@@ -270,7 +271,6 @@ void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::si
     trackChunk(*parts_.front(), events, begin, end);
   }
   timing_.events += end - begin;
-  if (pool_) timing_.worker_cpu_s = pool_->workerCpuSeconds();
   for (auto& part : parts_) {
     timing_.events_s += part->timing.events_s;
     timing_.optimisation_s += part->timing.optimisation_s;
@@ -343,33 +343,7 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
   return sol;
 }
 
-/// The parts' points of one chunk into out_, in the order one thread
-/// produces them: by event index, then by slot (bits are visited low to high).
-void EkltTracker::mergeChunkPoints() {
-  if (parts_.size() == 1) {
-    for (const ChunkPoint& c : parts_.front()->points) out_.push_back(c.point);
-    parts_.front()->points.clear();
-    return;
-  }
-  std::size_t heads[256] = {};  // threads <= 256 (constructor)
-  while (true) {
-    const ChunkPoint* best = nullptr;
-    std::size_t best_part = 0;
-    for (std::size_t k = 0; k < parts_.size(); ++k) {
-      const auto& pts = parts_[k]->points;
-      if (heads[k] == pts.size()) continue;
-      const ChunkPoint& c = pts[heads[k]];
-      if (!best || c.event < best->event || (c.event == best->event && c.slot < best->slot)) {
-        best = &c;
-        best_part = k;
-      }
-    }
-    if (!best) break;
-    out_.push_back(best->point);
-    ++heads[best_part];
-  }
-  for (auto& part : parts_) part->points.clear();
-}
+void EkltTracker::mergeChunkPoints() { estimator::mergeChunkPoints(part_points_, out_); }
 
 void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
   const Stopwatch start;

@@ -45,7 +45,7 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
   if (options_.tracker == "eklt")
     tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C, options_.threads);
   else if (options_.tracker == "haste")
-    tracker_ = std::make_unique<HasteTracker>(options_.haste, camera);
+    tracker_ = std::make_unique<HasteTracker>(options_.haste, camera, options_.threads);
   else
     tracker_ = std::make_unique<KltTracker>(options_.klt, camera);
   if (options_.image_source == "reconstructed")

@@ -23,14 +23,28 @@ struct HasteTracker::Slot {
   bool pending = false;           // the state moved since the last point sent
 };
 
-HasteTracker::HasteTracker(const HasteOptions& options, const Camera& camera)
+/// One part of the feature partition: slots s with s mod parts == its index.
+struct HasteTracker::Part {
+  Part(int width, int height, int num_slots) : grid(width, height, num_slots) { points.reserve(256); }
+  FeatureGrid grid;                // the bits of this part's slots only
+  std::vector<ChunkPoint> points;  // of the current chunk, in (event, slot) order
+  HasteCounters counters;          // feature_updates and jumps of the current chunk
+};
+
+HasteTracker::HasteTracker(const HasteOptions& options, const Camera& camera, int threads)
     : options_(options),
       width_(camera.width()),
       height_(camera.height()),
       half_(0.5 * (options.patch_size_px - 1)),
-      border_px_(options.lost_border_px),
-      grid_(camera.width(), camera.height(), options.max_features) {
+      border_px_(options.lost_border_px) {
   options_.validate();
+  require(threads >= 1 && threads <= 256, "HasteTracker: threads must be in [1, 256]");
+  const int num_parts = std::min(threads, options_.max_features);
+  for (int k = 0; k < num_parts; ++k) {
+    parts_.push_back(std::make_unique<Part>(width_, height_, options_.max_features));
+    part_points_.push_back(&parts_.back()->points);
+  }
+  if (num_parts > 1) pool_ = std::make_unique<WorkerPool>(num_parts);
   slots_.reserve(static_cast<std::size_t>(options_.max_features));
   for (int i = 0; i < options_.max_features; ++i) slots_.emplace_back(options_);
   const std::size_t n = static_cast<std::size_t>(options_.history_events);
@@ -74,13 +88,13 @@ void HasteTracker::moveRect(int index) {
   Slot& s = slots_[static_cast<std::size_t>(index)];
   const PixelRect rect = rangeRect(s.feature.state().x, s.feature.state().y);
   if (rect.x0 == s.rect.x0 && rect.y0 == s.rect.y0 && rect.x1 == s.rect.x1 && rect.y1 == s.rect.y1) return;
-  grid_.move(index, s.rect, rect);
+  partOf(index).grid.move(index, s.rect, rect);
   s.rect = rect;
 }
 
 void HasteTracker::free(int index) {
   Slot& s = slots_[static_cast<std::size_t>(index)];
-  grid_.move(index, s.rect, PixelRect{});
+  partOf(index).grid.move(index, s.rect, PixelRect{});
   s.rect = PixelRect{};
   s.state = Slot::State::kFree;
 }
@@ -125,7 +139,7 @@ void HasteTracker::recordHistory(TimeNs t_ns, int x, int y) {
   history_count_ = std::min(history_count_ + 1, cap);
 }
 
-void HasteTracker::onUpdate(int index, HasteFeature::Update update) {
+void HasteTracker::onUpdate(Part& part, int index, HasteFeature::Update update, std::size_t event_index) {
   Slot& s = slots_[static_cast<std::size_t>(index)];
   if (update == HasteFeature::Update::kOutOfRange || update == HasteFeature::Update::kFilling) return;
   const HasteState& st = s.feature.state();
@@ -135,15 +149,16 @@ void HasteTracker::onUpdate(int index, HasteFeature::Update update) {
     s.pending = false;
     s.last_uv = uv;
     s.last_t_ns = st.t_ns;
-    out_.push_back(TrackPoint{s.id, st.t_ns, uv, 1.0, TrackStatus::kNew});
+    part.points.push_back(ChunkPoint{event_index, index, TrackPoint{s.id, st.t_ns, uv, 1.0, TrackStatus::kNew}});
     return;
   }
   if (update == HasteFeature::Update::kJump) {
-    ++counters_.jumps;
+    ++part.counters.jumps;
     const bool inside = st.x >= border_px_ && st.y >= border_px_ && st.x <= width_ - 1 - border_px_ &&
                         st.y <= height_ - 1 - border_px_;
     if (!inside) {
-      out_.push_back(TrackPoint{s.id, s.last_t_ns, s.last_uv, 1.0, TrackStatus::kLost});
+      part.points.push_back(
+          ChunkPoint{event_index, index, TrackPoint{s.id, s.last_t_ns, s.last_uv, 1.0, TrackStatus::kLost}});
       free(index);
       return;
     }
@@ -155,20 +170,45 @@ void HasteTracker::onUpdate(int index, HasteFeature::Update update) {
   s.pending = false;
   s.last_uv = uv;
   s.last_t_ns = st.t_ns;
-  out_.push_back(TrackPoint{s.id, st.t_ns, uv, 1.0, TrackStatus::kTracked});
+  part.points.push_back(ChunkPoint{event_index, index, TrackPoint{s.id, st.t_ns, uv, 1.0, TrackStatus::kTracked}});
 }
 
 void HasteTracker::addEvents(const EventArray& events, std::size_t begin, std::size_t end) {
   const auto& t = events.t();
   const auto& x = events.x();
   const auto& y = events.y();
-  const int words = grid_.words();
   for (std::size_t i = begin; i < end; ++i) {
     const int ex = x[i];
     const int ey = y[i];
     if (ex < 0 || ey < 0 || ex >= width_ || ey >= height_) throw Error("HasteTracker: event outside the sensor");
-    recordHistory(t[i], ex, ey);
-    const std::uint64_t* cell = grid_.at(ex, ey);
+  }
+  if (pool_) {
+    auto task = [&](int k) { trackChunk(*parts_[static_cast<std::size_t>(k)], events, begin, end); };
+    pool_->run(task);
+  } else {
+    trackChunk(*parts_.front(), events, begin, end);
+  }
+  for (auto& part : parts_) {
+    counters_.feature_updates += part->counters.feature_updates;
+    counters_.jumps += part->counters.jumps;
+    part->counters = HasteCounters{};
+  }
+  mergeChunkPoints(part_points_, out_);
+  // The history is read only when a feature is seeded (addFrame): recorded
+  // after the chunk was tracked, it is the same as recorded event by event.
+  for (std::size_t i = begin; i < end; ++i) recordHistory(t[i], x[i], y[i]);
+  counters_.events += end - begin;
+}
+
+void HasteTracker::trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end) {
+  const auto& t = events.t();
+  const auto& x = events.x();
+  const auto& y = events.y();
+  const int words = part.grid.words();
+  for (std::size_t i = begin; i < end; ++i) {
+    const int ex = x[i];
+    const int ey = y[i];
+    const std::uint64_t* cell = part.grid.at(ex, ey);
     for (int w = 0; w < words; ++w) {
       std::uint64_t bits = cell[w];  // a copy: a jump may rewrite the grid
       while (bits != 0) {
@@ -176,12 +216,11 @@ void HasteTracker::addEvents(const EventArray& events, std::size_t begin, std::s
         bits &= bits - 1;
         Slot& s = slots_[static_cast<std::size_t>(index)];
         const HasteFeature::Update u = s.feature.addEvent(t[i], ex, ey);
-        if (u == HasteFeature::Update::kRegular || u == HasteFeature::Update::kJump) ++counters_.feature_updates;
-        onUpdate(index, u);
+        if (u == HasteFeature::Update::kRegular || u == HasteFeature::Update::kJump) ++part.counters.feature_updates;
+        onUpdate(part, index, u, i);
       }
     }
   }
-  counters_.events += end - begin;
 }
 
 void HasteTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {

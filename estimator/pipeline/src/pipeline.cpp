@@ -385,8 +385,8 @@ void PipelineRun::loop() {
     result_.counts.events_kept = last_consumed_.counts.events_kept;
     result_.counts.frames = last_consumed_.counts.frames;
     result_.counts.track_points = last_consumed_.counts.track_points;
+    result_.cpu.tracking_s += frontend_->trackerWorkerCpuSeconds();
     if (const EkltTiming* t = frontend_->ekltTiming()) {
-      result_.cpu.tracking_s += t->worker_cpu_s;
       result_.cpu.eklt_optimisation_s = t->optimisation_s;
       result_.cpu.eklt_events_s = t->splattingS();
       result_.cpu.eklt_frames_s = t->frame_s;

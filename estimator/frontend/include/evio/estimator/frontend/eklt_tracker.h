@@ -34,6 +34,7 @@
 #include "evio/core/camera/camera.h"
 #include "evio/core/pose.h"
 #include "evio/estimator/frontend/eklt_options.h"
+#include "evio/estimator/frontend/chunk_points.h"
 #include "evio/estimator/frontend/eklt_solver.h"
 #include "evio/estimator/frontend/feature_grid.h"
 #include "evio/estimator/frontend/feature_tracker.h"
@@ -57,7 +58,6 @@ struct EkltTiming {
   std::uint64_t solver_iterations = 0;
   std::uint64_t reversal_solves = 0;  ///< second solves from φ + π (EkltOptions::reversal_quality)
   std::uint64_t batches_dropped = 0;  ///< batches without a plausible solution (max_batch_shift_px)
-  double worker_cpu_s = 0.0;  ///< CPU seconds of the worker threads (threads > 1; the caller's thread excluded)
   /// Splatting and lookup: events_s − optimisation_s.
   double splattingS() const { return events_s - optimisation_s; }
 };
@@ -78,6 +78,7 @@ class EkltTracker final : public FeatureTracker {
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
   std::string_view name() const override { return "eklt"; }
+  double workerCpuSeconds() const override { return pool_ ? pool_->workerCpuSeconds() : 0.0; }
 
   /// Starts a feature by hand, bypassing detection and bootstrap: template
   /// from (gx, gy) of a log image around x0 (the position at the template
@@ -102,13 +103,6 @@ class EkltTracker final : public FeatureTracker {
  private:
   struct Slot;
   struct Part;
-  /// A track point of an event chunk with what orders it: the index of the
-  /// event that completed the batch, then the slot.
-  struct ChunkPoint {
-    std::size_t event;
-    int slot;
-    TrackPoint point;
-  };
   void splat(Slot& s, double x, double y, bool positive, TimeNs t_ns);
   void trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end);
   void mergeChunkPoints();
@@ -139,6 +133,7 @@ class EkltTracker final : public FeatureTracker {
   std::vector<Slot> slots_;
   std::vector<std::unique_ptr<Part>> parts_;  // slot s belongs to part s mod parts_.size()
   std::unique_ptr<WorkerPool> pool_;          // null with one thread
+  std::vector<std::vector<ChunkPoint>*> part_points_;  // each part's points, for the merge
   std::unique_ptr<GyroPredictor> predictor_;
   TrackPoints out_;
   FeatureId next_id_ = 0;

@@ -43,6 +43,10 @@ class FeatureTracker {
 
   /// "eklt", "klt" or "haste".
   virtual std::string_view name() const = 0;
+
+  /// CPU seconds spent so far by the tracker's own worker threads (features
+  /// tracked in parallel; the caller's thread not included); 0 without.
+  virtual double workerCpuSeconds() const { return 0.0; }
 };
 
 }  // namespace evio::estimator

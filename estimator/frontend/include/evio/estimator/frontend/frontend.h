@@ -25,8 +25,8 @@ namespace evio::estimator {
 struct FrontendOptions {
   std::string tracker = "eklt";          ///< eklt | klt | haste
   std::string image_source = "frames";   ///< frames | reconstructed (from events)
-  /// Threads tracking features in parallel (EKLT; the other trackers use
-  /// one). The output is byte-identical for any value (eklt_tracker.h).
+  /// Threads tracking features in parallel (EKLT and HASTE; KLT uses one).
+  /// The output is byte-identical for any value (eklt_tracker.h).
   int threads = 1;
   EventPrefilterOptions prefilter;  ///< for the pre-filter that runs before the frontend
   EkltOptions eklt;
@@ -38,7 +38,7 @@ struct FrontendOptions {
   void fields(V& v) {
     v("tracker", tracker, "eklt, klt or haste");
     v("image_source", image_source, "frames or reconstructed");
-    v("threads", threads, "threads tracking features in parallel (EKLT), same output for any value");
+    v("threads", threads, "threads tracking features in parallel (EKLT, HASTE), same output for any value");
     v("prefilter", prefilter, "event pre-filters");
     v("eklt", eklt, "EKLT tracker");
     v("klt", klt, "KLT tracker");

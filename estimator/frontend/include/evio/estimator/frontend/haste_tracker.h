@@ -22,14 +22,17 @@
 /// Memory is fixed at construction (max_features features, a per-pixel
 /// bitmask, the event history ring); processing an event allocates nothing.
 
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "evio/core/camera/camera.h"
+#include "evio/estimator/frontend/chunk_points.h"
 #include "evio/estimator/frontend/feature_grid.h"
 #include "evio/estimator/frontend/feature_tracker.h"
 #include "evio/estimator/frontend/haste_feature.h"
 #include "evio/estimator/frontend/haste_options.h"
+#include "evio/estimator/frontend/worker_pool.h"
 
 namespace evio::estimator {
 
@@ -43,7 +46,10 @@ struct HasteCounters {
 class HasteTracker final : public FeatureTracker {
  public:
   /// `camera`: the event camera (its resolution and the frames' size).
-  HasteTracker(const HasteOptions& options, const Camera& camera);
+  /// `threads` ≥ 1: features tracked in parallel, slot s on part s mod
+  /// threads with its own pixel bitmask, points merged in the single-thread
+  /// order (chunk_points.h): the same output for any thread count.
+  HasteTracker(const HasteOptions& options, const Camera& camera, int threads = 1);
   ~HasteTracker() override;
 
   void addFrame(TimeNs t_ns, const cv::Mat& image) override;
@@ -53,6 +59,7 @@ class HasteTracker final : public FeatureTracker {
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
   std::string_view name() const override { return "haste"; }
+  double workerCpuSeconds() const override { return pool_ ? pool_->workerCpuSeconds() : 0.0; }
 
   /// Seeds a feature by hand at `uv`, time t_ns, rotation θ (as a frame's
   /// corner would be, with the centred initialisation). Returns its id.
@@ -65,12 +72,15 @@ class HasteTracker final : public FeatureTracker {
 
  private:
   struct Slot;
+  struct Part;
+  Part& partOf(int index) { return *parts_[static_cast<std::size_t>(index) % parts_.size()]; }
+  void trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end);
   PixelRect rangeRect(double x, double y) const;
   int freeSlot() const;
   void seed(int index, const Vec2& uv, TimeNs t_ns, double theta);
   void moveRect(int index);
   void free(int index);
-  void onUpdate(int index, HasteFeature::Update update);
+  void onUpdate(Part& part, int index, HasteFeature::Update update, std::size_t event_index);
   void recordHistory(TimeNs t_ns, int x, int y);
 
   HasteOptions options_;
@@ -79,7 +89,9 @@ class HasteTracker final : public FeatureTracker {
   double half_;
   double border_px_;
   std::vector<Slot> slots_;
-  FeatureGrid grid_;
+  std::vector<std::unique_ptr<Part>> parts_;           // slot s belongs to part s mod parts_.size()
+  std::vector<std::vector<ChunkPoint>*> part_points_;  // each part's points, for the merge
+  std::unique_ptr<WorkerPool> pool_;                   // null with one thread
   // Ring of the last history_events events (centred initialisation).
   std::vector<std::int32_t> history_x_, history_y_;
   std::vector<TimeNs> history_t_;

@@ -68,6 +68,8 @@ class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
   std::uint64_t numFrames() const { return frames_; }
   /// The EKLT tracker's own time split; null for the other trackers.
   const EkltTiming* ekltTiming() const;
+  /// CPU seconds of the tracker's worker threads (features in parallel).
+  double trackerWorkerCpuSeconds() const { return frontend_.tracker().workerCpuSeconds(); }
 
  private:
   Frontend frontend_;

@@ -1,9 +1,10 @@
-// EKLT with its features tracked in parallel (EkltTracker `threads`): the
+// EKLT and HASTE with their features tracked in parallel (`threads`): the
 // track points must be the same bits, in the same order, for any number of
-// threads, and the single-thread output is pinned by a hash so that a change
-// of the tracker's arithmetic (a faster evaluation, another summation order)
-// cannot pass unnoticed.
+// threads, and EKLT's single-thread output is pinned by a hash so that a
+// change of the tracker's arithmetic (a faster evaluation, another summation
+// order) cannot pass unnoticed.
 #include "evio/estimator/frontend/eklt_tracker.h"
+#include "evio/estimator/frontend/haste_tracker.h"
 
 #include <gtest/gtest.h>
 
@@ -48,16 +49,10 @@ struct Scene {
   }
 };
 
-TrackPoints track(int threads, EkltTiming* timing = nullptr) {
+/// Feeds the scene to `tracker` (EkltTracker or HasteTracker) and returns its points.
+template <class Tracker>
+TrackPoints feedScene(Tracker& tracker) {
   const Scene& scene = Scene::get();
-  EkltOptions options;
-  options.batch_contrast_threshold = kContrast;
-  options.max_features = 30;
-  options.min_features = 24;
-  options.harris_quality_level = 0.02;
-  options.position_covariance = true;
-  const Camera camera = Camera::create("pinhole", kWidth, kHeight, Vec4(120, 120, 79.5, 59.5), VecX());
-  EkltTracker tracker(options, camera, std::nullopt, threads);
   std::size_t next = 0;
   for (std::size_t f = 0; f < scene.frames.size(); ++f) {
     const TimeNs t_frame = secondsToNs(static_cast<double>(f) * Scene::kFrameDtS);
@@ -69,7 +64,32 @@ TrackPoints track(int threads, EkltTiming* timing = nullptr) {
   }
   TrackPoints points;
   tracker.drainTrackPoints(points);
+  return points;
+}
+
+Camera sceneCamera() { return Camera::create("pinhole", kWidth, kHeight, Vec4(120, 120, 79.5, 59.5), VecX()); }
+
+TrackPoints track(int threads, EkltTiming* timing = nullptr) {
+  EkltOptions options;
+  options.batch_contrast_threshold = kContrast;
+  options.max_features = 30;
+  options.min_features = 24;
+  options.harris_quality_level = 0.02;
+  options.position_covariance = true;
+  EkltTracker tracker(options, sceneCamera(), std::nullopt, threads);
+  TrackPoints points = feedScene(tracker);
   if (timing) *timing = tracker.timing();
+  return points;
+}
+
+TrackPoints trackHaste(int threads, HasteCounters* counters = nullptr) {
+  HasteOptions options;
+  options.max_features = 30;
+  options.min_features = 24;
+  options.harris_quality_level = 0.02;
+  HasteTracker tracker(options, sceneCamera(), threads);
+  TrackPoints points = feedScene(tracker);
+  if (counters) *counters = tracker.counters();
   return points;
 }
 
@@ -119,6 +139,20 @@ TEST(EkltThreads, TrackPointsAreTheSameBitsForAnyThreadCount) {
   EXPECT_GE(lost, 5);
   EXPECT_GT(born, 30);  // more features than slots over the run: slots were re-used
   for (int threads : {2, 3, 7}) expectSamePoints(one, track(threads), threads);
+}
+
+TEST(HasteThreads, TrackPointsAreTheSameBitsForAnyThreadCount) {
+  HasteCounters counters;
+  const TrackPoints one = trackHaste(1, &counters);
+  int lost = 0, born = 0;
+  for (const TrackPoint& p : one) {
+    lost += p.status == TrackStatus::kLost;
+    born += p.status == TrackStatus::kNew;
+  }
+  EXPECT_GT(counters.jumps, 500u);
+  EXPECT_GE(lost, 5);
+  EXPECT_GT(born, 30);
+  for (int threads : {2, 3, 7}) expectSamePoints(one, trackHaste(threads), threads);
 }
 
 // The single-thread output of this scene, pinned at commit "EKLT features in

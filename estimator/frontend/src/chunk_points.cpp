@@ -1,0 +1,34 @@
+#include "evio/estimator/frontend/chunk_points.h"
+
+#include "evio/core/error.h"
+
+namespace evio::estimator {
+
+void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackPoints& out) {
+  require(parts.size() <= 256, "mergeChunkPoints: at most 256 parts");
+  if (parts.size() == 1) {
+    for (const ChunkPoint& c : *parts.front()) out.push_back(c.point);
+    parts.front()->clear();
+    return;
+  }
+  std::size_t heads[256] = {};
+  while (true) {
+    const ChunkPoint* best = nullptr;
+    std::size_t best_part = 0;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const std::vector<ChunkPoint>& pts = *parts[k];
+      if (heads[k] == pts.size()) continue;
+      const ChunkPoint& c = pts[heads[k]];
+      if (!best || c.event < best->event || (c.event == best->event && c.slot < best->slot)) {
+        best = &c;
+        best_part = k;
+      }
+    }
+    if (!best) break;
+    out.push_back(best->point);
+    ++heads[best_part];
+  }
+  for (std::vector<ChunkPoint>* p : parts) p->clear();
+}
+
+}  // namespace evio::estimator

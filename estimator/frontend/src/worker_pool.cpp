@@ -1,5 +1,7 @@
 #include "evio/estimator/frontend/worker_pool.h"
 
+#include <algorithm>
+
 #include "evio/core/error.h"
 #include "evio/core/stopwatch.h"
 
@@ -8,6 +10,7 @@ namespace evio::estimator {
 WorkerPool::WorkerPool(int size) {
   require(size >= 1, "WorkerPool: size must be >= 1");
   errors_.resize(static_cast<std::size_t>(size));
+  part_cpu_s_.assign(static_cast<std::size_t>(size), 0.0);
   threads_.reserve(static_cast<std::size_t>(size - 1));
   for (int k = 1; k < size; ++k) threads_.emplace_back([this, k] { workerLoop(k); });
 }
@@ -38,10 +41,19 @@ void WorkerPool::runParts(PartFn fn, void* context) {
     ++generation_;
   }
   start_.notify_all();
+  const double cpu0 = Stopwatch::threadCpuSeconds();
   runPart(0);
+  const double part0_cpu = Stopwatch::threadCpuSeconds() - cpu0;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [this] { return pending_ == 0; });
+    part_cpu_s_[0] = part0_cpu;
+    double slowest = 0.0;
+    for (double c : part_cpu_s_) {
+      cpu_.parts_s += c;
+      slowest = std::max(slowest, c);
+    }
+    cpu_.critical_path_s += slowest;
   }
   for (std::exception_ptr& e : errors_) {
     if (!e) continue;
@@ -66,7 +78,8 @@ void WorkerPool::workerLoop(int part) {
     bool last = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      worker_cpu_s_ += cpu;
+      cpu_.workers_s += cpu;
+      part_cpu_s_[static_cast<std::size_t>(part)] = cpu;
       last = --pending_ == 0;
     }
     if (last) done_.notify_one();

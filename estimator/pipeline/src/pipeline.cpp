@@ -385,7 +385,10 @@ void PipelineRun::loop() {
     result_.counts.events_kept = last_consumed_.counts.events_kept;
     result_.counts.frames = last_consumed_.counts.frames;
     result_.counts.track_points = last_consumed_.counts.track_points;
-    result_.cpu.tracking_s += frontend_->trackerWorkerCpuSeconds();
+    const WorkerPool::Cpu parallel = frontend_->trackerParallelCpu();
+    result_.cpu.tracking_s += parallel.workers_s;
+    result_.cpu.tracking_workers_s = parallel.workers_s;
+    result_.cpu.tracking_critical_path_s = result_.cpu.tracking_s - parallel.parts_s + parallel.critical_path_s;
     if (const EkltTiming* t = frontend_->ekltTiming()) {
       result_.cpu.eklt_optimisation_s = t->optimisation_s;
       result_.cpu.eklt_events_s = t->splattingS();

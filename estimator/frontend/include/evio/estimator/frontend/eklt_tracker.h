@@ -78,7 +78,7 @@ class EkltTracker final : public FeatureTracker {
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
   std::string_view name() const override { return "eklt"; }
-  double workerCpuSeconds() const override { return pool_ ? pool_->workerCpuSeconds() : 0.0; }
+  WorkerPool::Cpu parallelCpu() const override { return pool_ ? pool_->cpu() : WorkerPool::Cpu{}; }
 
   /// Starts a feature by hand, bypassing detection and bootstrap: template
   /// from (gx, gy) of a log image around x0 (the position at the template

@@ -14,6 +14,7 @@
 
 #include "evio/core/event.h"
 #include "evio/core/imu_sample.h"
+#include "evio/estimator/frontend/worker_pool.h"
 #include "evio/estimator/measurements.h"
 
 namespace evio::estimator {
@@ -44,9 +45,9 @@ class FeatureTracker {
   /// "eklt", "klt" or "haste".
   virtual std::string_view name() const = 0;
 
-  /// CPU seconds spent so far by the tracker's own worker threads (features
-  /// tracked in parallel; the caller's thread not included); 0 without.
-  virtual double workerCpuSeconds() const { return 0.0; }
+  /// CPU time of the features tracked in parallel so far (worker_pool.h);
+  /// zeros for a tracker on one thread.
+  virtual WorkerPool::Cpu parallelCpu() const { return {}; }
 };
 
 }  // namespace evio::estimator

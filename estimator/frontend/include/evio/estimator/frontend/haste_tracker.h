@@ -59,7 +59,7 @@ class HasteTracker final : public FeatureTracker {
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
   std::string_view name() const override { return "haste"; }
-  double workerCpuSeconds() const override { return pool_ ? pool_->workerCpuSeconds() : 0.0; }
+  WorkerPool::Cpu parallelCpu() const override { return pool_ ? pool_->cpu() : WorkerPool::Cpu{}; }
 
   /// Seeds a feature by hand at `uv`, time t_ns, rotation θ (as a frame's
   /// corner would be, with the centred initialisation). Returns its id.

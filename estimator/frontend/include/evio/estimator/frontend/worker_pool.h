@@ -30,11 +30,19 @@ class WorkerPool {
 
   int size() const { return static_cast<int>(threads_.size()) + 1; }
 
-  /// CPU seconds the worker threads spent in their parts so far (thread CPU
-  /// clock; part 0 runs on the caller's thread and is not included).
-  double workerCpuSeconds() const {
+  /// CPU seconds spent in the parts so far (thread CPU clocks): by the
+  /// worker threads (part 0, on the caller's thread, not included), by all
+  /// parts, and the critical path: the sum over runs of the slowest part's
+  /// CPU time, i.e. what the runs would take on idle cores (thread wake-ups
+  /// not counted).
+  struct Cpu {
+    double workers_s = 0.0;
+    double parts_s = 0.0;
+    double critical_path_s = 0.0;
+  };
+  Cpu cpu() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return worker_cpu_s_;
+    return cpu_;
   }
 
   /// Calls task(k) for k = 0 … size()−1 (k = 0 here, the others on the
@@ -63,7 +71,8 @@ class WorkerPool {
   std::uint64_t generation_ = 0;  // incremented by every run
   int pending_ = 0;               // worker parts not finished in this run
   bool stop_ = false;
-  double worker_cpu_s_ = 0.0;
+  std::vector<double> part_cpu_s_;  // of the current run, per part
+  Cpu cpu_;
   std::vector<std::exception_ptr> errors_;  // per part
 };
 

@@ -90,7 +90,12 @@ struct PipelineStageTimes {
 struct PipelineStageCpu {
   double read_s = 0.0;       ///< reading events, IMU and frames (decoding PNG included)
   double prefilter_s = 0.0;  ///< event pre-filters
-  double tracking_s = 0.0;   ///< the frontend: reconstruction and tracker
+  double tracking_s = 0.0;   ///< the frontend: reconstruction and tracker (all its threads)
+  double tracking_workers_s = 0.0;        ///< of tracking_s, the tracker's worker threads
+  /// tracking_s with each chunk's parallel parts counted as their slowest
+  /// part: the tracking's wall time on idle cores (thread wake-ups not
+  /// counted); equals tracking_s on one thread.
+  double tracking_critical_path_s = 0.0;
   double sync_s = 0.0;       ///< synchroniser (tracks_ method: reading the tracks)
   double backend_s = 0.0;    ///< EKF propagation and updates
   double output_s = 0.0;     ///< health monitor, writing the estimate files, timing and progress
@@ -103,6 +108,9 @@ struct PipelineStageCpu {
     v("read_s", read_s, "reading events, IMU and frames, CPU s");
     v("prefilter_s", prefilter_s, "event pre-filters, CPU s");
     v("tracking_s", tracking_s, "frontend (reconstruction and tracker), CPU s");
+    v("tracking_workers_s", tracking_workers_s, "of tracking_s, the tracker's worker threads, CPU s");
+    v("tracking_critical_path_s", tracking_critical_path_s,
+      "tracking with each chunk's parallel parts counted as the slowest part, CPU s");
     v("sync_s", sync_s, "synchroniser, CPU s");
     v("backend_s", backend_s, "EKF propagation and updates, CPU s");
     v("output_s", output_s, "health monitor and estimate files, CPU s");

@@ -68,8 +68,8 @@ class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
   std::uint64_t numFrames() const { return frames_; }
   /// The EKLT tracker's own time split; null for the other trackers.
   const EkltTiming* ekltTiming() const;
-  /// CPU seconds of the tracker's worker threads (features in parallel).
-  double trackerWorkerCpuSeconds() const { return frontend_.tracker().workerCpuSeconds(); }
+  /// CPU time of the features tracked in parallel (worker_pool.h).
+  WorkerPool::Cpu trackerParallelCpu() const { return frontend_.tracker().parallelCpu(); }
 
  private:
   Frontend frontend_;

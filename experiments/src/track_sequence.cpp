@@ -115,7 +115,7 @@ CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
     size_from = " (size from " + info.resolution_source + ")";
   }
   return CameraChoice{io::cameraFromCalibTxt(io::readCalibTxt(calib.string()), width, height), std::nullopt,
-                      "calib.txt" + size_from};
+                      "calib.txt" + size_from, {}};  // calib.txt states no thresholds
 }
 
 }  // namespace

@@ -339,6 +339,7 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
     const bool reversed_ok = shift(reversed) <= max_shift;
     if (reversed_ok && (!sol_ok || reversed.cost < sol.cost)) sol = reversed;
   }
+  if (!sol.valid) return sol;  // nothing could be evaluated: the caller loses the feature, as before
   if (shift(sol) > max_shift) return std::nullopt;
   return sol;
 }

@@ -109,7 +109,8 @@ class EkltTracker final : public FeatureTracker {
   void optimise(Part& part, int slot_index, std::size_t event_index);
   /// The batch's solution from p0, re-solved from the reversed flow when
   /// implausible (EkltOptions::reversal_quality, max_batch_shift_px);
-  /// nullopt when neither moves the feature plausibly. Counts in `timing`.
+  /// nullopt when neither moves the feature plausibly (an invalid solution
+  /// is returned as it is: the feature is lost). Counts in `timing`.
   std::optional<EkltSolution> solveBatch(const Slot& s, const EkltBatch& batch, const Vec4& p0, const Vec2& predicted,
                                          EkltTiming& timing) const;
   void activate(int slot_index, const Vec2& uv, TimeNs t_ns, double flow_angle);

@@ -1,9 +1,5 @@
 #include "evio/simulator/event_camera.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -15,6 +11,7 @@
 #include "evio/core/error.h"
 #include "evio/simulator/counter_rng.h"
 #include "evio/simulator/fast_math.h"
+#include "parallel_for.h"
 #include "pending_sort.h"
 
 namespace evio::simulator {
@@ -282,17 +279,7 @@ void EventCamera::update(TimeNs t_ns, const float* radiance, EventArray* events,
     block_events_[b].clear();
     processBlock(b * kBlock, std::min(n_, (b + 1) * kBlock), t_ns, radiance, &block_events_[b]);
   };
-  if (options_.threads == 1 || blocks == 1) {
-    for (std::size_t b = 0; b < blocks; ++b) run(b);
-  } else {
-    tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t b = r.begin(); b != r.end(); ++b) run(b);
-                        });
-    });
-  }
+  parallelFor(options_.threads, blocks, 1, run);
   for (const auto& block : block_events_) pending_.insert(pending_.end(), block.begin(), block.end());
   uniform_ = true;
   uniform_t_ = t_ns;

@@ -1,9 +1,6 @@
 // EventCamera::updateRects (event_camera.h): whole rectangles of the image
 // (the tiles a render loop re-traced) through the vectorised pixel path,
 // row run by row run, blocks of runs in parallel.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <limits>
@@ -11,6 +8,7 @@
 
 #include "evio/core/error.h"
 #include "evio/simulator/event_camera.h"
+#include "parallel_for.h"
 
 namespace evio::simulator {
 
@@ -82,17 +80,7 @@ void EventCamera::updateRects(TimeNs t_ns, const std::vector<cv::Rect>& rects, c
                 t_ns);
     }
   };
-  if (options_.threads == 1 || blocks <= 1) {
-    for (std::size_t b = 0; b < blocks; ++b) run(b);
-  } else {
-    tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
-    arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t b = r.begin(); b != r.end(); ++b) run(b);
-                        });
-    });
-  }
+  parallelFor(options_.threads, blocks, 1, run);
   for (std::size_t b = 0; b < blocks; ++b)
     pending_.insert(pending_.end(), block_events_[b].begin(), block_events_[b].end());
   if (count > 0) t_max_sample_ = std::max(t_max_sample_, t_ns);

@@ -1,9 +1,5 @@
 #include "evio/simulator/tile_schedule.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,6 +7,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/options.h"
+#include "parallel_for.h"
 
 namespace evio::simulator {
 
@@ -129,16 +126,7 @@ void TileSchedule::reschedule(int tile, TimeNs t_ns, const cv::Mat& flow) {
 
 template <class F>
 void TileSchedule::forTiles(std::size_t count, const F& f) const {
-  if (threads_ == 1) {
-    for (std::size_t k = 0; k < count; ++k) f(k);
-    return;
-  }
-  tbb::task_arena arena = threads_ > 0 ? tbb::task_arena(threads_) : tbb::task_arena();
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t k = r.begin(); k != r.end(); ++k) f(k);
-    });
-  });
+  parallelFor(threads_, count, 16, f);
 }
 
 void TileSchedule::scheduleAll(TimeNs t_ns, const cv::Mat& radiance, const cv::Mat& flow) {

@@ -1,7 +1,10 @@
 #include "evio/estimator/backend/slam_features.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/QR>
 
+#include "evio/core/camera/camera_common.h"
+#include "evio/core/so3.h"
 #include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/visual_models.h"
 
@@ -23,6 +26,40 @@ bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const 
   H->block<2, 3>(0, state.featureIndex(j)) = Hf;
   *r = z - zh;
   return true;
+}
+
+bool slamSecondOrderCovariance(const FilterState& state, std::size_t j, std::size_t c, Mat2* cov) {
+  const SlamFeature& f = state.features[j];
+  const int a = state.findClone(f.anchor_clone_id);
+  if (a < 0) return false;
+  const CameraClone& anchor = state.clones[static_cast<std::size_t>(a)];
+  const CameraClone& clone = state.clones[c];
+  const Mat3 Rit = clone.R_W_C().transpose();
+  const Vec3 dp = anchor.p_W_C - clone.p_W_C;
+  const Vec3 h = Rit * (anchor.R_W_C() * Vec3(f.abr.x(), f.abr.y(), 1.0) + f.abr.z() * dp);
+  if (!(h.allFinite() && h.z() > 0.0)) return false;
+  // G over the state: +R_iᵀ on δp_a, −R_iᵀ on δp_i, [R_iᵀ dp]× on δθ_i (the
+  // position blocks cancel when the clone is the anchor).
+  Eigen::Matrix<double, 3, Eigen::Dynamic> G = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim());
+  G.block<3, 3>(0, state.cloneIndex(static_cast<std::size_t>(a)) + kCloneP) += Rit;
+  G.block<3, 3>(0, state.cloneIndex(c) + kCloneP) -= Rit;
+  G.block<3, 3>(0, state.cloneIndex(c) + kCloneTheta) += so3::hat(Rit * dp);
+  const int rho = state.featureIndex(j) + 2;
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> GP = G * state.P;
+  const Vec3 GP_rho = GP.col(rho);
+  const Mat3 cov_h = state.P(rho, rho) * (GP * G.transpose()) + GP_rho * GP_rho.transpose();
+  const Mat23 Pi = dNormalizedDPoint(h);
+  *cov = Pi * cov_h * Pi.transpose();
+  return cov->allFinite();
+}
+
+Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra) {
+  const Mat2 W_inv = whiten.inverse();
+  const Mat2 cov = sigma_z * sigma_z * W_inv * W_inv.transpose() + extra;
+  const Eigen::LLT<Mat2> llt(0.5 * (cov + cov.transpose()));
+  if (llt.info() != Eigen::Success) return whiten;
+  // cov = L Lᵀ ⇒ (σ_z L⁻¹) cov (σ_z L⁻¹)ᵀ = σ_z² I.
+  return sigma_z * llt.matrixL().solve(Mat2::Identity());
 }
 
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,

@@ -32,10 +32,14 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     Eigen::Matrix<double, 2, Eigen::Dynamic> H;
     Vec2 r;
     MatX Hc;
+    FeatureObservation obs = o;
+    Mat2 second_order;
+    if (options().slam_second_order_noise && slamSecondOrderCovariance(state(), jj, c, &second_order))
+      obs.whiten = whitenWithExtraCovariance(o.whiten, sigma_z_, second_order);
     const bool ok = slamResidual(state(), jj, c, o.z, &H, &r);
     if (ok) {
-      H = o.whiten * H;  // whitened to σ_z² I (feature_track.h)
-      r = o.whiten * r;
+      H = obs.whiten * H;  // whitened to σ_z² I (feature_track.h)
+      r = obs.whiten * r;
       Hc = H;
       constrain(&Hc);
     }
@@ -46,7 +50,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
       continue;
     }
     f.gate_failures = 0;
-    out.accepted.push_back(o);
+    out.accepted.push_back(obs);  // the update whitens with the same W as the gate
   }
   return out;
 }

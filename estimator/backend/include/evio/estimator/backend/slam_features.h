@@ -20,6 +20,24 @@ namespace evio::estimator {
 bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const Vec2& z,
                   Eigen::Matrix<double, 2, Eigen::Dynamic>* H, Vec2* r);
 
+/// Covariance (2 × 2, normalised image units) of the second-order term of
+/// SLAM feature j's observation in clone c that the EKF's linearisation drops
+/// (docs/algorithms.md#second-order-depth-term). With h = R_iᵀ(R_a b + ρ dp),
+/// dp = p_a − p_i, the product of the inverse depth and the clones' errors
+///   δh₂ = δρ · g,  g = R_iᵀ(δp_a − δp_i) + [R_iᵀ dp]× δθ_i = G δx,
+/// is bilinear in Gaussian errors, so (Isserlis) its covariance is exactly
+///   Cov(δh₂) = σ_ρ² G P_xx Gᵀ + (G P_xρ)(G P_xρ)ᵀ,
+/// mapped to the image by Π = ∂π/∂h. It matters for depth-prior features
+/// (σ_ρ of half of ρ): a 1 m⁻¹ prior and 1 cm between the clones give
+/// about 0.005 normalised, a pixel at f = 200 px. Zero in the anchor (dp = 0
+/// and δp_a = δp_i). False when the point is not in front of the clone.
+bool slamSecondOrderCovariance(const FilterState& state, std::size_t j, std::size_t c, Mat2* cov);
+
+/// The whitening of an observation whose covariance σ_z² W⁻¹W⁻ᵀ (W its
+/// whitening, feature_track.h) grows by `extra`: W' with
+/// W'(σ_z² W⁻¹W⁻ᵀ + extra)W'ᵀ = σ_z² I.
+Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra);
+
 /// Depth-prior initialisation (Montiel et al. 2006; xVIO): anchor = clone c,
 /// (α, β) = z, ρ = rho0, with covariance diag(Σ_z, σ_ρ0²) (Σ_z = σ_z² W⁻¹W⁻ᵀ,
 /// W the observation's whitening, feature_track.h; σ_z² I when W = I) and zero

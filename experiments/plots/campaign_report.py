@@ -6,7 +6,8 @@ Usage: campaign_report.py RESULTS REPORT_DIR GROUPS_CSV
 Reads RESULTS/summary.csv (one row per job), the per-job series
 RESULTS/jobs/<id>/metrics_poses.csv (t_s, distance_m, gt_x.., es_x..,
 position_m, rotation_deg, yaw_deg, gravity_deg, nees_*) and
-RESULTS/jobs/<id>/metrics_rtf.csv (t_s, rtf, event_rate_hz), and GROUPS_CSV
+RESULTS/jobs/<id>/metrics_rtf.csv (t_s, rtf, event_rate_hz, and features,
+rtf_per_feature when the estimate's timing.txt has the features column), and GROUPS_CSV
 (written by `evio report`: the ANEES bounds per group). Writes into
 REPORT_DIR:
   box_mpe.png, box_ate.png, box_mye.png  Monte Carlo box plots per scenario and method (successful runs)
@@ -15,6 +16,8 @@ REPORT_DIR:
   trajectories_<scenario>.png            top view (x-y) of the aligned estimates against ground truth
   nees.png                               average NEES over the runs against time, with 95 % chi-square bounds
   rtf_vs_event_rate.png                  real-time factor of 0.2 s intervals against the event rate
+  rtf_per_feature_vs_event_rate.png      the same RTF divided by the features tracked in each interval
+                                         (the EKLT-VIO paper's Fig. 6b; jobs without the column left out)
 and plots.txt: one line per figure, "wrote NAME" or "skipped NAME: reason".
 """
 
@@ -235,7 +238,11 @@ def nees_plot(rows, scenarios, series, groups, out):
     save(fig, out, "nees.png")
 
 
-def rtf_plot(rows, results, out):
+def rtf_scatter(rows, results, out, column, name, ylabel, missing):
+    """Scatter of metrics_rtf.csv's `column` against the event rate, one colour
+    per method, on a logarithmic y axis (RTF spans 0.1 to 100 across methods
+    and machines, per feature three decades lower); non-positive and empty
+    values left out."""
     fig, ax = plt.subplots(figsize=(6, 4.5))
     methods = sorted({r["method"] for r in rows})
     any_drawn = False
@@ -245,26 +252,35 @@ def rtf_plot(rows, results, out):
             if r["method"] != m or r["done"] != "1":
                 continue
             s = load_series(os.path.join(results, "jobs", r["job_id"], "metrics_rtf.csv"))
-            if s is not None and len(s["rtf"]) > 0:
+            if s is not None and column in s and len(s[column]) > 0:
                 xs.append(s["event_rate_hz"])
-                ys.append(s["rtf"])
+                ys.append(s[column])
         if xs:
             x, y = np.concatenate(xs), np.concatenate(ys)
-            keep = y > 0  # a logarithmic axis: RTF spans 0.1 to 100 across methods and machines
+            keep = np.isfinite(y) & (y > 0)
             if keep.any():
                 ax.scatter(x[keep], y[keep], s=4, alpha=0.4, color=f"C{i}", label=m)
                 any_drawn = True
     if not any_drawn:
         plt.close(fig)
-        note("skipped rtf_vs_event_rate.png: no job has a positive real-time factor (timing.txt → metrics_rtf.csv)")
+        note(f"skipped {name}: {missing}")
         return
-    ax.axhline(1.0, color="k", lw=0.8, ls="--")
+    if column == "rtf":
+        ax.axhline(1.0, color="k", lw=0.8, ls="--")
     ax.set_yscale("log")
     ax.set_xlabel("event rate [events/s]")
-    ax.set_ylabel("real-time factor (0.2 s intervals)")
+    ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    save(fig, out, "rtf_vs_event_rate.png")
+    save(fig, out, name)
+
+
+def rtf_plot(rows, results, out):
+    rtf_scatter(rows, results, out, "rtf", "rtf_vs_event_rate.png", "real-time factor (0.2 s intervals)",
+                "no job has a positive real-time factor (timing.txt → metrics_rtf.csv)")
+    rtf_scatter(rows, results, out, "rtf_per_feature", "rtf_per_feature_vs_event_rate.png",
+                "real-time factor per tracked feature (0.2 s intervals)",
+                "no job has an RTF per feature (timing.txt without its features column → metrics_rtf.csv)")
 
 
 def main():

@@ -70,7 +70,7 @@ def read_timing(path):
         for line in f:
             if line.startswith("#") or not line.strip():
                 continue
-            t, processing, events = line.split()
+            t, processing, events = line.split()[:3]  # a 4th column, features, since timing.txt gained it
             rows.append((float(t), float(processing), int(events)))
     return rows
 

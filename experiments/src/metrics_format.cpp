@@ -142,6 +142,10 @@ JsonValue metricsJson(const Metrics& m, const EvaluationOptions& options, const 
     rtf.set("max", JsonValue::number(m.rtf.max));
     rtf.set("overall", JsonValue::number(m.rtf.overall));
     rtf.set("mean_event_rate_hz", JsonValue::number(m.rtf.mean_event_rate_hz));
+    if (m.rtf.features_known) {
+      rtf.set("median_features", JsonValue::number(m.rtf.median_features));
+      rtf.set("median_per_feature", JsonValue::number(m.rtf.median_per_feature));
+    }
   }
 
   JsonValue& dv = j.set("divergence", JsonValue::object());
@@ -228,6 +232,9 @@ std::string metricsTable(const Metrics& m) {
          m.rtf.overall, m.rtf.mean_event_rate_hz);
   else
     appendLine(s, "real-time factor  n/a (no timing.txt)");
+  if (m.rtf.available && m.rtf.features_known)
+    appendLine(s, "RTF per feature   median %.3g (median %.1f features tracked)", m.rtf.median_per_feature,
+         m.rtf.median_features);
   appendLine(s, "divergence        %s (max error/bound %.3g)", m.divergence.diverged ? m.divergence.cause.c_str() : "no",
        m.divergence.max_ratio);
   return s;
@@ -260,13 +267,20 @@ std::string poseErrorsCsv(const Metrics& m) {
 }
 
 std::string rtfCsv(const Metrics& m) {
-  std::string s = "t_s,rtf,event_rate_hz\n";
+  const bool features = m.rtf.features_known;
+  std::string s = features ? "t_s,rtf,event_rate_hz,features,rtf_per_feature\n" : "t_s,rtf,event_rate_hz\n";
   for (const auto& r : m.rtf.samples) {
     appendNumber(s, r.t_s);
     s += ",";
     appendNumber(s, r.rtf);
     s += ",";
     appendNumber(s, r.event_rate_hz);
+    if (features) {
+      s += ",";
+      appendNumber(s, r.features);
+      s += ",";
+      appendNumber(s, r.rtf_per_feature);  // empty where no feature was tracked
+    }
     s += "\n";
   }
   return s;

@@ -22,6 +22,40 @@ std::pair<double, double> at(const std::vector<io::TimingSample>& timing, TimeNs
           static_cast<double>(a.events) + s * static_cast<double>(b.events - a.events)};
 }
 
+/// F_m of (g0, g1] (real_time_factor.h): the mean features of the rows with
+/// g0 < t <= g1, else the features of the last row at or before g1.
+double intervalFeatures(const std::vector<io::TimingSample>& timing, TimeNs g0, TimeNs g1) {
+  const auto by_t = [](const io::TimingSample& s, TimeNs t) { return s.t_ns <= t; };
+  const auto first = std::lower_bound(timing.begin(), timing.end(), g0, by_t);  // first row with t > g0
+  const auto end = std::lower_bound(first, timing.end(), g1, by_t);            // first row with t > g1
+  if (first == end) return end == timing.begin() ? 0.0 : static_cast<double>(*(end - 1)->features);
+  double sum = 0.0;
+  for (auto it = first; it != end; ++it) sum += static_cast<double>(*it->features);
+  return sum / static_cast<double>(end - first);
+}
+
+bool hasFeatures(const std::vector<io::TimingSample>& timing) {
+  return std::all_of(timing.begin(), timing.end(), [](const io::TimingSample& s) { return s.features.has_value(); });
+}
+
+/// Fills F_m, RTF_m / F_m and their medians.
+void addFeatures(const std::vector<io::TimingSample>& timing, TimeNs step, RtfMetrics& m) {
+  m.features_known = true;
+  std::vector<double> features, per_feature;
+  TimeNs g = timing.front().t_ns;
+  for (RtfSample& s : m.samples) {
+    s.features = intervalFeatures(timing, g, g + step);
+    if (s.features > 0.0) {
+      s.rtf_per_feature = s.rtf / s.features;
+      per_feature.push_back(s.rtf_per_feature);
+    }
+    features.push_back(s.features);
+    g += step;
+  }
+  m.median_features = errorStats(std::move(features)).median;
+  if (!per_feature.empty()) m.median_per_feature = errorStats(std::move(per_feature)).median;
+}
+
 }  // namespace
 
 RtfMetrics realTimeFactor(const std::vector<io::TimingSample>& timing, double grid_s) {
@@ -49,6 +83,7 @@ RtfMetrics realTimeFactor(const std::vector<io::TimingSample>& timing, double gr
   const ErrorStats stats = errorStats(std::move(rtf));
   m.median = stats.median;
   m.max = stats.max;
+  if (hasFeatures(timing)) addFeatures(timing, step, m);
   return m;
 }
 

@@ -20,6 +20,7 @@
 #include "evio/estimator/pipeline/groundtruth_init.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "evio/simulator/sequence_simulator.h"
+#include "support/timing_columns.h"
 #include "temp_dir.h"
 
 namespace evio::estimator {
@@ -111,12 +112,16 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCount) {
     const std::string config = std::to_string(configs[k].first) + " threads" + (configs[k].second ? " + backend thread" : "");
     for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
       EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[k] + "/" + file)) << file << ", " << config;
+    // timing.txt: the same rows, events and features (the processing time is the machine's).
+    EXPECT_TRUE(test::timingWithoutClock(outs[0] + "/timing.txt") == test::timingWithoutClock(outs[k] + "/timing.txt"))
+        << config;
     EXPECT_EQ(counts[0].events, counts[k].events) << config;
     EXPECT_EQ(counts[0].track_points, counts[k].track_points) << config;
     EXPECT_EQ(counts[0].measurement_sets, counts[k].measurement_sets) << config;
     EXPECT_EQ(counts[0].poses, counts[k].poses) << config;
   }
   EXPECT_FALSE(io::readFile(outs[0] + "/trajectory.txt").empty());
+  EXPECT_TRUE(test::anyFeatures(test::timingWithoutClock(outs[0] + "/timing.txt")));
 }
 
 // HASTE-VIO alike: 1 thread against 2 tracker threads and the backend
@@ -136,6 +141,9 @@ TEST_F(PipelineSimulated, HasteVioEstimatesAreByteIdenticalForAnyThreadCount) {
   }
   for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
     EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[1] + "/" + file)) << file;
+  const test::TimingColumns timing = test::timingWithoutClock(outs[0] + "/timing.txt");
+  EXPECT_TRUE(test::anyFeatures(timing));
+  EXPECT_TRUE(timing == test::timingWithoutClock(outs[1] + "/timing.txt"));
 }
 
 TEST_F(PipelineSimulated, KltVio) { runAndCheck(fromGroundTruth("klt-vio"), "klt", 40); }

@@ -5,7 +5,10 @@
 // one clear message, or a status — never a crash).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 
 #include "evio/core/io/atomic_file.h"
@@ -16,10 +19,12 @@
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/io/status_yaml.h"
 #include "evio/core/io/timing_txt.h"
+#include "evio/core/io/tracks_txt.h"
 #include "evio/core/io/tum.h"
 #include "evio/estimator/pipeline/groundtruth_init.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "temp_dir.h"
+#include "support/timing_columns.h"
 #include "support/tiny_sequence.h"
 
 namespace evio::estimator {
@@ -111,6 +116,40 @@ TEST(Pipeline, TracksMethodFollowsTheGroundTruthAndWritesTheEstimateFolder) {
   EXPECT_NE(expected.frontend.eklt.batch_contrast_threshold, 0.0);
   EXPECT_TRUE(config::equal(back, expected));
   EXPECT_TRUE(fs::exists(out + "/summary.yaml"));
+}
+
+// timing.txt's features column holds the size of the latest measurement set
+// at or before each row's time. With the `tracks` method at 20 Hz on file
+// times every 10 ms from 0, the sets come at 50, 100, 150 ms, … (the first
+// one period after the first point, synchronizer.cpp) and the set at a
+// multiple of 50 ms holds exactly the file's samples at that time
+// (tracks_input.h), so the expected count of a row at t is the number of
+// truth/tracks.txt samples at floor(t / 50 ms), and 0 for the row at
+// initialisation (t = 0, before the first set).
+TEST(Pipeline, TimingFeaturesAreTheSizeOfTheLatestMeasurementSet) {
+  test::TempDir dir;
+  const std::string seq = dir.file("seq"), out = dir.file("out");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  writeTinySequence(seq, so);
+  std::map<TimeNs, std::int64_t> samples_at;
+  for (const io::TrackSample& s : io::readTracksText(seq + "/truth/tracks.txt")) ++samples_at[s.t_ns];
+  const PipelineResult r = runPipeline(seq, tracksOptions(), out);
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  const auto timing = io::readTimingText(out + "/timing.txt");
+  ASSERT_GE(timing.size(), 25u);  // a row every 0.1 s of data
+  const TimeNs period = 50'000'000;
+  std::set<std::int64_t> counts;
+  for (const io::TimingSample& row : timing) {
+    ASSERT_TRUE(row.features.has_value());
+    const TimeNs set_t = row.t_ns / period * period;
+    ASSERT_EQ(samples_at.count(set_t), 1u) << set_t;
+    const std::int64_t expected = set_t == 0 ? 0 : samples_at[set_t];
+    EXPECT_EQ(*row.features, expected) << "row at " << nsToSeconds(row.t_ns) << " s";
+    counts.insert(*row.features);
+  }
+  std::printf("timing.txt: %zu rows, feature counts %lld to %lld\n", timing.size(),
+              static_cast<long long>(*counts.begin()), static_cast<long long>(*counts.rbegin()));
 }
 
 TEST(Pipeline, SameInputSameSeedGivesIdenticalTrajectories) {
@@ -240,6 +279,9 @@ TEST(PipelineBadInput, BackendThreadFailsAtTheSameItemAsOneThread) {
       EXPECT_EQ(io::readFile(dir.file(std::string(method) + "_1/" + file)),
                 io::readFile(dir.file(std::string(method) + "_2/" + file)))
           << method << " " << file;
+    const test::TimingColumns timing = test::timingWithoutClock(dir.file(std::string(method) + "_1/timing.txt"));
+    EXPECT_TRUE(test::anyFeatures(timing)) << method;
+    EXPECT_EQ(timing, test::timingWithoutClock(dir.file(std::string(method) + "_2/timing.txt"))) << method;
   }
 }
 

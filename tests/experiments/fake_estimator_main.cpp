@@ -7,7 +7,8 @@
 // (d the distance travelled), sampled at rate_hz from start_s after the
 // first ground-truth time, with trajectory_covariance.txt stating σ_p², σ_θ²
 // (so NEES ≈ 6 without offset and drift), timing.txt with processing time
-// rtf · (data time) and event_rate_hz events per second, and status.yaml
+// rtf · (data time), event_rate_hz events per second and `features` tracked
+// features, and status.yaml
 // (diverged at diverge_at_s, when >= 0: the output stops there). Seeds in
 // crash_seeds abort (SIGABRT) before writing anything, like a crashing estimator.
 //
@@ -42,7 +43,8 @@ int run(int argc, char** argv) {
                                      {"offset_m", 0.0},          {"drift_percent", 0.0},
                                      {"yaw_drift_deg_per_s", 0.0}, {"noise_position_m", 0.01},
                                      {"noise_rotation_rad", 0.002}, {"rtf", 0.4},
-                                     {"event_rate_hz", 3e5},     {"diverge_at_s", -1.0}};
+                                     {"event_rate_hz", 3e5},     {"diverge_at_s", -1.0},
+                                     {"features", 45.0}};
   std::set<std::uint64_t> crash_seeds;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -115,7 +117,8 @@ int run(int argc, char** argv) {
     estimate.push_back({t, es});
     covariance.push_back({t, es, Mat3::Identity() * sr * sr, Mat3::Identity() * sp * sp});
     const double data_s = nsToSeconds(t - t0);
-    timing.push_back({t, p["rtf"] * data_s, static_cast<std::int64_t>(std::llround(p["event_rate_hz"] * data_s))});
+    timing.push_back({t, p["rtf"] * data_s, static_cast<std::int64_t>(std::llround(p["event_rate_hz"] * data_s)),
+                      static_cast<std::int64_t>(std::llround(p["features"]))});
   }
   io::writeTum((std::filesystem::path(output) / "trajectory.txt").string(), estimate,
                {"fake estimate (evio_fake_estimator): t px py pz qx qy qz qw"});

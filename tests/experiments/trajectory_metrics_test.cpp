@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <numbers>
+#include <tuple>
 
 #include "evio/core/error.h"
 #include "evio/core/random_stream.h"
@@ -240,7 +241,7 @@ TEST(TrajectoryMetrics, RealTimeFactorOnTheGrid) {
   double processing = 0.0;
   for (int k = 0; k <= 90; ++k) {  // from 1 s to 10 s every 0.1 s
     const double t = 1.0 + 0.1 * k;
-    timing.push_back({secondsToNs(t), processing, 100'000 * k});  // 1e6 events/s
+    timing.push_back({secondsToNs(t), processing, 100'000 * k, std::nullopt});  // 1e6 events/s; 3 columns
     processing += t < 5.0 ? 0.05 : 0.2;  // RTF 0.5, then 2.0
   }
   in.timing = timing;
@@ -253,6 +254,54 @@ TEST(TrajectoryMetrics, RealTimeFactorOnTheGrid) {
   EXPECT_NEAR(m.rtf.median, 2.0, 1e-9);  // 20 intervals at 0.5, 25 at 2.0
   EXPECT_NEAR(m.rtf.samples[3].event_rate_hz, 1e6, 1e-3);
   EXPECT_NEAR(m.rtf.overall, (20 * 0.1 + 25 * 0.4) / 9.0, 1e-9);
+}
+
+// The features column of timing.txt in metrics_rtf.csv (real_time_factor.h):
+// F_m is the mean of the rows inside the interval, or the count at its end
+// when no row falls inside; RTF per feature = RTF_m / F_m, empty for F_m = 0.
+// On a 0.25 s grid with rows every 0.125 s, processing times in multiples of
+// 1/16 s and the one interpolated grid point halfway between two rows, every
+// value below is exact in binary, so the text is compared whole.
+TEST(TrajectoryMetrics, RealTimeFactorPerTrackedFeature) {
+  EvaluationInputs in;
+  in.groundtruth = test::straightLine(3.0, 0.01, 1.0);
+  in.estimate = in.groundtruth;
+  // t [s], processing [s], events, features; no row between 1.75 and 2.25 s.
+  const std::vector<std::tuple<double, double, std::int64_t, std::int64_t>> rows = {
+      {1.0, 0.0, 0, 0},        {1.125, 0.125, 1000, 0},   {1.25, 0.25, 2000, 0},  {1.375, 0.375, 3000, 10},
+      {1.5, 0.5, 4000, 30},    {1.625, 0.5625, 5000, 40}, {1.75, 0.625, 6000, 40}, {2.25, 0.875, 10000, 50}};
+  std::vector<io::TimingSample> timing;
+  for (const auto& [t, p, events, features] : rows) timing.push_back({secondsToNs(t), p, events, features});
+  in.timing = timing;
+  EvaluationOptions options;
+  options.rtf_grid_s = 0.25;
+  const Metrics m = evaluateTrajectory(in, options);
+  ASSERT_TRUE(m.rtf.features_known);
+  EXPECT_EQ(rtfCsv(m),
+            "t_s,rtf,event_rate_hz,features,rtf_per_feature\n"
+            "1,1,8000,0,\n"              // rows 1.125 and 1.25: no feature, no RTF per feature
+            "1.25,1,8000,20,0.05\n"      // rows 1.375 and 1.5: mean of 10 and 30
+            "1.5,0.5,8000,40,0.0125\n"   // rows 1.625 and 1.75
+            "1.75,0.5,8000,40,0.0125\n"  // no row inside: the count at 2.0 s (row 1.75); P and N halfway
+            "2,0.5,8000,50,0.01\n");     // row 2.25
+  EXPECT_EQ(m.rtf.median_features, 40.0);        // of 0, 20, 40, 40, 50
+  EXPECT_EQ(m.rtf.median_per_feature, 0.0125);   // of the four intervals with features
+  const JsonValue j = metricsJson(m, options, {});
+  EXPECT_EQ(j.at("rtf.median_per_feature")->asDouble(), 0.0125);
+  EXPECT_EQ(j.at("rtf.median_features")->asDouble(), 40.0);
+  EXPECT_NE(metricsTable(m).find("RTF per feature   median 0.0125 (median 40.0 features tracked)"), std::string::npos)
+      << metricsTable(m);
+
+  // A timing.txt from before the column: the RTF series as before, nothing invented.
+  for (io::TimingSample& s : timing) s.features.reset();
+  in.timing = timing;
+  const Metrics old = evaluateTrajectory(in, options);
+  EXPECT_FALSE(old.rtf.features_known);
+  EXPECT_EQ(rtfCsv(old), "t_s,rtf,event_rate_hz\n1,1,8000\n1.25,1,8000\n1.5,0.5,8000\n1.75,0.5,8000\n2,0.5,8000\n");
+  const JsonValue j_old = metricsJson(old, options, {});
+  EXPECT_EQ(j_old.at("rtf.median_per_feature"), nullptr);
+  EXPECT_EQ(j_old.at("rtf.median_features"), nullptr);
+  EXPECT_EQ(metricsTable(old).find("per feature"), std::string::npos);
 }
 
 TEST(TrajectoryMetrics, AssociationInterpolatesAndRefusesTooFewMatches) {

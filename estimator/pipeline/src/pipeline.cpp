@@ -98,6 +98,9 @@ class PipelineRun {
   void writeTiming(TimeNs t_ns, std::uint64_t events_read);
   void finish();
   io::EstimateStatus finalStatus() const;
+  /// timing.txt's features: those of the latest measurement set the backend
+  /// side took (the same for any frontend.threads and backend_thread).
+  std::int64_t trackedFeatures() const { return static_cast<std::int64_t>(backend_stage_->lastSetFeatures()); }
   /// Processing time since the loop started on the clock of output.timing_clock.
   double elapsed() const {
     return cpu_clock_ ? Stopwatch::processCpuSeconds() - loop_start_cpu_s_ : loop_watch_.seconds();
@@ -333,7 +336,7 @@ void PipelineRun::writeTiming(TimeNs t_ns, std::uint64_t events_read) {
     return;
   const TimeNs t = timing_started_ ? t_ns : std::max(t_ns, *result_.initialization_t_ns);
   if (timing_started_ && t <= last_timing_t_) return;
-  writer_->addTiming(io::TimingSample{t, processing, static_cast<std::int64_t>(events_read)});
+  writer_->addTiming(io::TimingSample{t, processing, static_cast<std::int64_t>(events_read), trackedFeatures()});
   timing_started_ = true;
   last_timing_t_ = t;
 }
@@ -426,7 +429,7 @@ io::EstimateStatus PipelineRun::finalStatus() const {
 void PipelineRun::finish() {
   if (timing_started_ && last_consumed_.t_now > last_timing_t_)
     writer_->addTiming(io::TimingSample{last_consumed_.t_now, elapsed(),
-                                        static_cast<std::int64_t>(last_consumed_.events_read)});
+                                        static_cast<std::int64_t>(last_consumed_.events_read), trackedFeatures()});
   result_.backend = backend_->stats();
   result_.counts.poses = writer_->numPoses();
   result_.status = finalStatus();

@@ -109,6 +109,7 @@ void BackendStage::process(BackendInput& in, std::vector<Estimate>& out) {
   } else if (const auto* set = std::get_if<MeasurementSet>(&in)) {
     backend_.addMeasurementSet(*set);
     ++measurement_sets_;
+    last_set_features_ = set->features.size();
   } else {
     const auto& range = std::get<RangeMeasurement>(in);
     backend_.addRange(range.t_ns, range.range_m);

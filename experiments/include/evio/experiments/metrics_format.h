@@ -19,7 +19,8 @@
 ///       gravity_deg{...}}...}                              labels "10pct", "5m", …
 ///   nees{available, alignment, rotation_error, poses, singular, mean_pose, mean_position,
 ///        mean_orientation, share_in_bounds, bounds_pose_95[2]}
-///   rtf{available, grid_s, intervals, median, max, overall, mean_event_rate_hz}
+///   rtf{available, grid_s, intervals, median, max, overall, mean_event_rate_hz,
+///       median_features, median_per_feature}   (the last two when timing.txt has features)
 ///   divergence{alignment, diverged, time_s, cause, max_ratio, fraction_of_distance, offset_m}
 ///   completion{alignment, share, max_gap_s}
 /// Every group whose numbers depend on the alignment carries the alignment's
@@ -28,7 +29,9 @@
 /// The per-pose series (metrics_poses.csv):
 ///   t_s,distance_m,gt_x,gt_y,gt_z,es_x,es_y,es_z,position_m,rotation_deg,yaw_deg,
 ///   gravity_deg,nees_position,nees_orientation,nees_pose      (NEES empty where absent)
-/// and the RTF series (metrics_rtf.csv): t_s,rtf,event_rate_hz.
+/// and the RTF series (metrics_rtf.csv): t_s,rtf,event_rate_hz, then
+/// features,rtf_per_feature when timing.txt has the features column
+/// (real_time_factor.h; rtf_per_feature empty where no feature was tracked).
 
 #include <string>
 

@@ -107,11 +107,15 @@ class BackendStage : public Stage<BackendInput, Estimate> {
   BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer);
   void process(BackendInput& in, std::vector<Estimate>& out) override;
   std::uint64_t numMeasurementSets() const { return measurement_sets_; }
+  /// Features in the latest measurement set received (0 before the first):
+  /// timing.txt's features column.
+  std::size_t lastSetFeatures() const { return last_set_features_; }
 
  private:
   Backend& backend_;
   std::optional<GroundTruthInitializer> initializer_;
   std::uint64_t measurement_sets_ = 0;
+  std::size_t last_set_features_ = 0;
 };
 
 }  // namespace evio::estimator

@@ -128,6 +128,46 @@ TEST(Synchronizer, CompensatesAKnownTrackerLatencyAlongTheTrackVelocity) {
   EXPECT_THROW(Synchronizer{o}, Error);
 }
 
+// A tracker whose lag is a + τ|v| (a px in distance, τ in time): the lag
+// of EKLT measured against the simulator's truth. Compensating both gives
+// the true position at the set time exactly, for a slow and a fast track;
+// the distance alone leaves the slow one's τ|v| (small) and the fast one's
+// (large) behind.
+TEST(Synchronizer, CompensatesALagInDistanceAndTimeAtAnySpeed) {
+  const double a = 0.4, tau = 0.0013;
+  const Vec2 uv0(40, 30), slow(12, -9), fast(800, 600);  // px, px/s: |slow| 15, |fast| 1000
+  const auto lagged = [&](FeatureId id, const Vec2& v, double t, TrackStatus st = TrackStatus::kTracked) {
+    return point(id, t, linear(uv0, v, t - tau) - a * v.normalized(), st);
+  };
+  SynchronizerOptions o;
+  o.n_e = 10;
+  o.track_latency_s = tau;
+  o.track_lag_px = a;
+  SynchronizerOptions distance_only = o;
+  distance_only.track_latency_s = 0.0;
+  Synchronizer sync(o), partial(distance_only);
+  for (Synchronizer* s : {&sync, &partial}) {
+    s->addTrackPoints({lagged(1, slow, 0.010, TrackStatus::kNew), lagged(2, fast, 0.010, TrackStatus::kNew),
+                       lagged(1, slow, 0.012), lagged(2, fast, 0.012), lagged(1, slow, 0.014),
+                       lagged(2, fast, 0.014)});
+    s->addEvents(10, secondsToNs(0.014));
+  }
+  MeasurementSet set, set_partial;
+  ASSERT_TRUE(sync.poll(&set));
+  ASSERT_TRUE(partial.poll(&set_partial));
+  ASSERT_EQ(set.features.size(), 2u);
+  for (const FeatureMeasurement& m : set.features) {
+    const Vec2 truth = linear(uv0, m.id == 1 ? slow : fast, 0.014);
+    EXPECT_LT((m.uv - truth).norm(), 1e-9) << "feature " << m.id;
+  }
+  for (const FeatureMeasurement& m : set_partial.features) {
+    const Vec2 v = m.id == 1 ? slow : fast;
+    EXPECT_NEAR((m.uv - linear(uv0, v, 0.014)).norm(), v.norm() * tau, 1e-9) << "feature " << m.id;
+  }
+  o.track_lag_px = 11.0;  // beyond the range [0, 10] px
+  EXPECT_THROW(Synchronizer{o}, Error);
+}
+
 TEST(Synchronizer, UpdateTimeMustBeStrictlyAfterThePreviousAndLostTracksLeave) {
   SynchronizerOptions o;
   o.n_e = 10;

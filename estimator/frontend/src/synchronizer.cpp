@@ -17,6 +17,7 @@ void SynchronizerOptions::validate() const {
   requireNonNegative("max_extrapolation_s", max_extrapolation_s);
   requireInRange("min_displacement_px", min_displacement_px, 0.0, 100.0);
   requireInRange("track_latency_s", track_latency_s, 0.0, 0.05);
+  requireInRange("track_lag_px", track_lag_px, 0.0, 10.0);
 }
 
 Synchronizer::Synchronizer(const SynchronizerOptions& options) : options_(options) {
@@ -109,7 +110,11 @@ Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
   const TimeNs horizon = secondsToNs(options_.max_extrapolation_s);
   const TimeNs t = std::min(t_ns, tr.t[1] + horizon);
   const double s = static_cast<double>(t - tr.t[1]) / static_cast<double>(tr.t[1] - tr.t[0]);
-  return tr.uv[1] + s * (tr.uv[1] - tr.uv[0]);
+  const Vec2 step = tr.uv[1] - tr.uv[0];
+  const double length = step.norm();
+  // The lag in distance, a px along the direction of the last step.
+  const Vec2 lag = length > 0.0 ? Vec2(options_.track_lag_px / length * step) : Vec2::Zero();
+  return tr.uv[1] + s * step + lag;
 }
 
 void Synchronizer::update(TimeNs t_ns) {

@@ -11,7 +11,9 @@
 ///  - "track_time": whenever the latest track timestamp advances (e.g. KLT,
 ///    whose points all carry frame times: one update per frame).
 /// With track_latency_s = τ > 0 the extrapolation goes to t_s + τ instead:
-/// the latency of the tracker compensated along each track's velocity.
+/// the latency of the tracker compensated along each track's velocity; with
+/// track_lag_px = a > 0 the position is moved a further a px along the
+/// track's direction (a lag in distance, independent of the speed).
 /// Each feature of a set is flagged informative (measurements.h) unless
 /// drop_repeated_points and it has no new track point since the previous
 /// update, or it moved less than min_displacement_px since its last
@@ -56,6 +58,11 @@ struct SynchronizerOptions {
   /// extrapolation to t_s + τ (from its last two points, the track's
   /// velocity). 0: the points are taken as stamped.
   double track_latency_s = 0.0;
+  /// The tracker's lag in distance, px: a track point lies this far behind
+  /// the feature along the track's direction of motion (from its last two
+  /// points), whatever the speed; each sent position is moved forward by it.
+  /// With track_latency_s = τ the lag of a point is a + τ |v|. 0: none.
+  double track_lag_px = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -67,6 +74,7 @@ struct SynchronizerOptions {
     v("drop_repeated_points", drop_repeated_points, "features without a new track point are not informative");
     v("min_displacement_px", min_displacement_px, "motion since the last informative position, px");
     v("track_latency_s", track_latency_s, "tracker latency compensated along the track's velocity, s");
+    v("track_lag_px", track_lag_px, "tracker lag along the track's direction compensated, px");
   }
   void validate() const;
 };

@@ -17,7 +17,13 @@ of the true positions; the along-motion lag is
 
 Samples slower than --min-speed px/s (direction ill-defined) and the first
 sample of each track (the detection, exact by construction) are skipped.
-Prints the medians overall and per speed band.
+Prints the medians overall and per speed band, and the least-squares fit of
+
+    lag_px = a + tau |v|                    (a px in distance, tau s in time)
+
+over the samples whose error is below --max-error px (lost tracks left out):
+the model that `sync.track_lag_px = a` and `sync.track_latency_s = tau`
+compensate (estimator/frontend/synchronizer.h).
 """
 import argparse
 import os
@@ -42,6 +48,7 @@ def main():
     ap.add_argument("tracks")
     ap.add_argument("truth")
     ap.add_argument("--min-speed", type=float, default=50.0, help="px/s")
+    ap.add_argument("--max-error", type=float, default=5.0, help="px: samples farther off are left out of the fit")
     a = ap.parse_args()
     est, truth = read(a.tracks), read(a.truth)
     lags = []  # (speed px/s, lag px, lag s)
@@ -59,7 +66,7 @@ def main():
                 continue
             ex, ey = e[round(t, 9)]
             lag_px = -((ex - x) * vx + (ey - y) * vy) / speed
-            lags.append((speed, lag_px, lag_px / speed))
+            lags.append((speed, lag_px, lag_px / speed, ((ex - x) ** 2 + (ey - y) ** 2) ** 0.5))
     if not lags:
         sys.exit("no samples faster than --min-speed with a true position")
     print(f"samples {len(lags)}: median lag {statistics.median(l[1] for l in lags):.3f} px, "
@@ -72,6 +79,26 @@ def main():
         print(f"  {lo:>4.0f}-{hi if hi < 1e9 else float('inf'):>4.0f} px/s: n {len(sel):6d}, "
               f"lag {statistics.median(l[1] for l in sel):.3f} px, "
               f"latency {1e3 * statistics.median(l[2] for l in sel):.2f} ms")
+    fit = [l for l in lags if l[3] <= a.max_error]
+    if len(fit) >= 2:
+        a_px, tau_s = fitLag(fit)
+        rms = (sum(l[1] ** 2 for l in fit) / len(fit)) ** 0.5
+        rms_fit = (sum((l[1] - a_px - tau_s * l[0]) ** 2 for l in fit) / len(fit)) ** 0.5
+        print(f"fit over {len(fit)} samples within {a.max_error:g} px: lag = a + tau |v| with "
+              f"a = {a_px:.3f} px, tau = {1e3 * tau_s:.2f} ms; along-motion rms {rms:.3f} px -> {rms_fit:.3f} px")
+
+
+def fitLag(samples):
+    """Least squares of lag_px = a + tau * speed: the 2 x 2 normal equations."""
+    n = len(samples)
+    s1 = sum(l[0] for l in samples)
+    s2 = sum(l[0] * l[0] for l in samples)
+    r1 = sum(l[1] for l in samples)
+    r2 = sum(l[0] * l[1] for l in samples)
+    det = n * s2 - s1 * s1
+    if det <= 0.0:
+        return r1 / n, 0.0
+    return (s2 * r1 - s1 * r2) / det, (n * r2 - s1 * r1) / det
 
 
 if __name__ == "__main__":

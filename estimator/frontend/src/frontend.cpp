@@ -20,6 +20,7 @@ void FrontendOptions::validate() const {
   validateSection("klt", klt);
   validateSection("haste", haste);
   validateSection("reconstruction", reconstruction);
+  validateSection("track_lag", track_lag);
 }
 
 FrontendOptions resolveSensorParameters(FrontendOptions options,
@@ -50,6 +51,8 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
     tracker_ = std::make_unique<KltTracker>(options_.klt, camera);
   if (options_.image_source == "reconstructed")
     reconstructor_ = std::make_unique<ImageReconstructor>(options_.reconstruction, camera.width(), camera.height());
+  if (options_.track_lag.estimate && options_.tracker != "klt")
+    probe_ = std::make_unique<FrameLagProbe>(options_.track_lag);
 }
 
 Frontend::~Frontend() = default;
@@ -73,7 +76,16 @@ void Frontend::addEvents(const EventArray& events) {
   }
 }
 
+void Frontend::drainTrackPoints(TrackPoints& out) {
+  const std::size_t begin = out.size();
+  tracker_->drainTrackPoints(out);
+  if (probe_) probe_->observe(out, begin);
+}
+
 void Frontend::addFrame(TimeNs t_ns, const cv::Mat& image) {
+  // The probe first: it compares the event tracks up to this frame with the
+  // frame, then sees the tracker's new seeds on it (drainTrackPoints).
+  if (probe_) probe_->addFrame(t_ns, image);
   if (reconstructor_)
     reconstructor_->addFrame(t_ns, image);
   else

@@ -23,6 +23,7 @@ void SynchronizerOptions::validate() const {
 Synchronizer::Synchronizer(const SynchronizerOptions& options) : options_(options) {
   options_.validate();
   latency_ns_ = secondsToNs(options_.track_latency_s);
+  lag_px_ = options_.track_lag_px;
   trigger_ = options_.trigger == "events"       ? Trigger::kEvents
              : options_.trigger == "fixed_rate" ? Trigger::kFixedRate
                                                 : Trigger::kTrackTime;
@@ -105,6 +106,11 @@ void Synchronizer::advanceTime(TimeNs t_ns) {
   }
 }
 
+void Synchronizer::setTrackLag(double a_px, double tau_s) {
+  lag_px_ = std::max(0.0, a_px);
+  latency_ns_ = secondsToNs(std::max(0.0, tau_s));
+}
+
 Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
   if (tr.n < 2 || tr.t[1] == tr.t[0]) return tr.uv[1];
   const TimeNs horizon = secondsToNs(options_.max_extrapolation_s);
@@ -113,7 +119,7 @@ Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
   const Vec2 step = tr.uv[1] - tr.uv[0];
   const double length = step.norm();
   // The lag in distance, a px along the direction of the last step.
-  const Vec2 lag = length > 0.0 ? Vec2(options_.track_lag_px / length * step) : Vec2::Zero();
+  const Vec2 lag = length > 0.0 ? Vec2(lag_px_ / length * step) : Vec2::Zero();
   return tr.uv[1] + s * step + lag;
 }
 

@@ -397,6 +397,7 @@ void PipelineRun::loop() {
       result_.cpu.eklt_events_s = t->splattingS();
       result_.cpu.eklt_frames_s = t->frame_s;
     }
+    result_.track_lag = frontend_->trackLag();
   }
   result_.counts.measurement_sets = backend_stage_->numMeasurementSets();
 }

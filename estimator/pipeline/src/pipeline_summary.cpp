@@ -41,6 +41,12 @@ std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions
   writer.write(r.cpu);
   out << YAML::Key << "backend" << YAML::Value;
   writer.write(r.backend);
+  if (r.track_lag) {  // the model lag = a + tau |v| the synchroniser compensated at the end
+    out << YAML::Key << "track_lag" << YAML::Value << YAML::BeginMap;
+    emitSeconds(out, "a_px", r.track_lag->a_px);
+    emitSeconds(out, "tau_s", r.track_lag->tau_s);
+    out << YAML::EndMap;
+  }
   out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
   for (const auto& n : r.notes) out << n;
   out << YAML::EndSeq;

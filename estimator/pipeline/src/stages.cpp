@@ -47,6 +47,7 @@ void FrontendStage::process(SequenceItem& in, std::vector<FrontendOutput>& out) 
       frontend_.addFrame(in.t_ns, in.image);
       ++frames_;
       frontend_.drainTrackPoints(o.points);
+      o.lag = frontend_.trackLag();
       break;
     case SequenceItem::Kind::kImu: {
       ImuSample camera_clock = in.imu;
@@ -68,7 +69,10 @@ void SynchronizerStage::process(FrontendOutput& in, std::vector<BackendInput>& o
   }
   switch (in.kind) {
     case SequenceItem::Kind::kEvents: sync_.addEvents(in.events, in.t_ns); break;
-    case SequenceItem::Kind::kFrame: sync_.advanceTime(in.t_ns); break;
+    case SequenceItem::Kind::kFrame:
+      if (in.lag) sync_.setTrackLag(in.lag->a_px, in.lag->tau_s);
+      sync_.advanceTime(in.t_ns);
+      break;
     case SequenceItem::Kind::kImu:
       sync_.advanceTime(in.t_ns);
       out.emplace_back(in.imu);

@@ -19,6 +19,7 @@
 #include "evio/estimator/frontend/haste_options.h"
 #include "evio/estimator/frontend/image_reconstructor.h"
 #include "evio/estimator/frontend/klt_tracker.h"
+#include "evio/estimator/frontend/track_lag.h"
 
 namespace evio::estimator {
 
@@ -33,6 +34,7 @@ struct FrontendOptions {
   KltOptions klt;
   HasteOptions haste;
   ImageReconstructorOptions reconstruction;
+  TrackLagOptions track_lag;  ///< the event tracker's lag estimated from the frames (track_lag.h)
 
   template <class V>
   void fields(V& v) {
@@ -44,6 +46,7 @@ struct FrontendOptions {
     v("klt", klt, "KLT tracker");
     v("haste", haste, "HASTE tracker");
     v("reconstruction", reconstruction, "event-based image reconstruction");
+    v("track_lag", track_lag, "online estimate of the event tracker's lag");
   }
   void validate() const;
 };
@@ -72,7 +75,11 @@ class Frontend {
   void addFrame(TimeNs t_ns, const cv::Mat& image);
   void addImu(const ImuSample& sample);
 
-  void drainTrackPoints(TrackPoints& out) { tracker_->drainTrackPoints(out); }
+  /// Appends the track points since the last call (the lag probe sees them too).
+  void drainTrackPoints(TrackPoints& out);
+  /// The event tracker's lag estimated from the frames (track_lag.estimate,
+  /// EKLT and HASTE on sensor frames); nullopt while there are too few samples.
+  std::optional<TrackLag> trackLag() const { return probe_ ? probe_->lag() : std::nullopt; }
   FeatureTracker& tracker() { return *tracker_; }
   const FeatureTracker& tracker() const { return *tracker_; }
 
@@ -84,6 +91,7 @@ class Frontend {
   FrontendOptions options_;
   std::unique_ptr<FeatureTracker> tracker_;
   std::unique_ptr<ImageReconstructor> reconstructor_;
+  std::unique_ptr<FrameLagProbe> probe_;
   std::uint64_t events_ = 0;
   std::uint64_t reconstructed_frames_ = 0;
 };

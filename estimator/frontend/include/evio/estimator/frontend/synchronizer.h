@@ -81,6 +81,10 @@ struct SynchronizerOptions {
 
 class Synchronizer {
  public:
+  /// Replaces the compensated lag (track_latency_s, track_lag_px) from the
+  /// next set on: the frontend's online estimate (track_lag.h). Negative
+  /// parts are taken as 0.
+  void setTrackLag(double a_px, double tau_s);
   explicit Synchronizer(const SynchronizerOptions& options);
 
   /// Track points in the order the tracker produced them.
@@ -124,7 +128,8 @@ class Synchronizer {
   bool any_time_ = false;
   TimeNs next_fixed_ns_ = -1;
   TimeNs latest_point_ns_ = 0;
-  TimeNs latency_ns_ = 0;  // track_latency_s
+  TimeNs latency_ns_ = 0;  // track_latency_s (or setTrackLag)
+  double lag_px_ = 0.0;    // track_lag_px (or setTrackLag)
 };
 
 }  // namespace evio::estimator

@@ -154,6 +154,9 @@ struct PipelineResult {
   TimeNs t_first_ns = 0;           ///< data span read (camera clock)
   TimeNs t_last_ns = 0;
   std::optional<TimeNs> initialization_t_ns;
+  /// The tracker's lag estimated from the frames at the end
+  /// (frontend.track_lag.estimate; track_lag.h).
+  std::optional<TrackLag> track_lag;
   std::vector<std::string> notes;  ///< degraded modes and choices made (one line each)
 };
 

@@ -39,6 +39,9 @@ struct FrontendOutput {
   std::uint64_t events = 0;     ///< kEvents: events that reached the tracker
   ImuSample imu;                ///< kImu (IMU clock)
   io::RangeSample range;        ///< kRange
+  /// kFrame: the frontend's estimate of its tracker's lag after this frame
+  /// (frontend.track_lag.estimate), for the synchroniser to compensate.
+  std::optional<TrackLag> lag;
 };
 
 /// What the backend consumes: IMU samples (IMU clock), measurement sets and
@@ -70,6 +73,8 @@ class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
   const EkltTiming* ekltTiming() const;
   /// CPU time of the features tracked in parallel (worker_pool.h).
   WorkerPool::Cpu trackerParallelCpu() const { return frontend_.tracker().parallelCpu(); }
+  /// The frontend's current estimate of its tracker's lag (track_lag.h).
+  std::optional<TrackLag> trackLag() const { return frontend_.trackLag(); }
 
  private:
   Frontend frontend_;

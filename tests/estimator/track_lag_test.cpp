@@ -37,6 +37,19 @@ TEST(TrackLagFit, AtOneSpeedGivesTheLagAtThatSpeed) {
   EXPECT_NEAR(lag.a_px + lag.tau_s * 200.0, 0.8, 0.01);
 }
 
+TEST(TrackLagFit, ALeadIsNotALag) {
+  // Samples whose best free fit has τ < 0 (lag falling with speed): the fit
+  // keeps τ = 0 and fits a alone, the mean lag (prior: one sample at 0).
+  TrackLagFit fit;
+  for (int k = 0; k < 400; ++k) {
+    const double speed = 100.0 + k;
+    fit.add(speed, 0.5 - 0.001 * speed);
+  }
+  const TrackLag lag = fit.solve();
+  EXPECT_EQ(lag.tau_s, 0.0);
+  EXPECT_NEAR(lag.a_px, (0.5 - 0.001 * 299.5) * 400.0 / 401.0, 1e-9);
+}
+
 TEST(TrackLagOptions, BadValuesNameTheField) {
   TrackLagOptions o;
   o.window_px = 20;

@@ -1,5 +1,6 @@
 #include "evio/estimator/frontend/track_lag.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <opencv2/video/tracking.hpp>
@@ -38,14 +39,24 @@ void TrackLagFit::add(double speed_pxps, double lag_px) {
 
 TrackLag TrackLagFit::solve() const {
   // Normal equations of Σ (lag − a − τ s)² + a² + (τ kSpeedScale)²:
-  //   [n + 1, Σs; Σs, Σs² + S²] [a; τ] = [Σlag; Σs·lag].
+  //   [n + 1, Σs; Σs, Σs² + S²] [a; τ] = [Σlag; Σs·lag],
+  // with a ≥ 0 and τ ≥ 0 (a lag, not a lead): when the free solution has a
+  // negative part, that part is 0 and the other is fitted alone.
   const double m00 = n_ + 1.0, m01 = s1_, m11 = s2_ + kSpeedScale * kSpeedScale;
   const double det = m00 * m11 - m01 * m01;
   TrackLag out;
   if (!(det > 0.0)) return out;
   out.a_px = (m11 * r1_ - m01 * r2_) / det;
   out.tau_s = (m00 * r2_ - m01 * r1_) / det;
-  return out;
+  if (out.a_px >= 0.0 && out.tau_s >= 0.0) return out;
+  const TrackLag distance_only{std::max(0.0, r1_ / m00), 0.0};
+  const TrackLag time_only{0.0, std::max(0.0, r2_ / m11)};
+  // The better of the two one-parameter fits (the smaller residual sum).
+  const auto cost = [&](const TrackLag& x) {
+    return m00 * x.a_px * x.a_px + 2.0 * m01 * x.a_px * x.tau_s + m11 * x.tau_s * x.tau_s -
+           2.0 * (x.a_px * r1_ + x.tau_s * r2_);
+  };
+  return cost(distance_only) <= cost(time_only) ? distance_only : time_only;
 }
 
 // --- FrameLagProbe -------------------------------------------------------------------

@@ -115,12 +115,11 @@ Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
   if (tr.n < 2 || tr.t[1] == tr.t[0]) return tr.uv[1];
   const TimeNs horizon = secondsToNs(options_.max_extrapolation_s);
   const TimeNs t = std::min(t_ns, tr.t[1] + horizon);
-  const double s = static_cast<double>(t - tr.t[1]) / static_cast<double>(tr.t[1] - tr.t[0]);
   const Vec2 step = tr.uv[1] - tr.uv[0];
   const double length = step.norm();
   // The lag in distance, a px along the direction of the last step.
   const Vec2 lag = length > 0.0 ? Vec2(lag_px_ / length * step) : Vec2::Zero();
-  return tr.uv[1] + s * step + lag;
+  return extrapolateLinearly(tr.t[0], tr.uv[0], tr.t[1], tr.uv[1], t) + lag;
 }
 
 void Synchronizer::update(TimeNs t_ns) {

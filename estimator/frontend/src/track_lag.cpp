@@ -6,6 +6,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "evio/core/error.h"
+#include "evio/estimator/frontend/synchronizer.h"
 
 namespace evio::estimator {
 
@@ -94,8 +95,7 @@ void FrameLagProbe::observe(const TrackPoints& points, std::size_t begin) {
 std::optional<Vec2> FrameLagProbe::eventPosition(const Feature& f, TimeNs t_ns) const {
   if (f.n < 2 || f.t[1] <= f.t[0] || f.t[1] > t_ns) return std::nullopt;
   if (nsToSeconds(t_ns - f.t[1]) > options_.max_point_age_s) return std::nullopt;
-  const double s = static_cast<double>(t_ns - f.t[1]) / static_cast<double>(f.t[1] - f.t[0]);
-  return Vec2(f.uv[1] + s * (f.uv[1] - f.uv[0]));
+  return extrapolateLinearly(f.t[0], f.uv[0], f.t[1], f.uv[1], t_ns);
 }
 
 void FrameLagProbe::sample(const Feature& f, const Vec2& s_prev, const Vec2& s, TimeNs t_ns, double dt) {

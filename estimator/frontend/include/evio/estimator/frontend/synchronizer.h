@@ -79,6 +79,15 @@ struct SynchronizerOptions {
   void validate() const;
 };
 
+/// A track's position at t, extrapolated along the line through its last
+/// two points (t0, uv0) and (t1, uv1), t0 < t1: uv1 + (t − t1)/(t1 − t0)·(uv1 − uv0).
+/// The synchroniser sends tracks this way; the lag probe (track_lag.h)
+/// compares the same extrapolation with the frames.
+inline Vec2 extrapolateLinearly(TimeNs t0, const Vec2& uv0, TimeNs t1, const Vec2& uv1, TimeNs t) {
+  const double s = static_cast<double>(t - t1) / static_cast<double>(t1 - t0);
+  return uv1 + s * (uv1 - uv0);
+}
+
 class Synchronizer {
  public:
   /// Replaces the compensated lag (track_latency_s, track_lag_px) from the

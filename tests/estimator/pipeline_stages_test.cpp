@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <variant>
 
 #include "evio/core/error.h"
+#include "evio/core/io/health_txt.h"
 #include "evio/core/io/tum.h"
 #include "evio/estimator/pipeline/health_monitor.h"
 #include "evio/estimator/pipeline/method.h"
@@ -157,7 +159,7 @@ TEST(PipelineStages, GroundTruthInitializerWaitsForItsTimeAndStartsFromTheTruth)
 Estimate update(int k, double nis, int dof, int accepted = 5) {
   Estimate e;
   e.t_ns = static_cast<TimeNs>(k) * 10'000'000;
-  e.innovation = InnovationStats{nis, dof, accepted, 0};
+  e.innovation = InnovationStats{nis, dof, accepted, 0, nis, dof};  // all accepted
   e.cov_pose_B.diagonal().setConstant(1e-4);
   return e;
 }
@@ -222,6 +224,83 @@ TEST(HealthMonitorStage, TheWindowedRatioGivesDegradedThenDivergedAtTheirFirstTi
   }
   EXPECT_EQ(monitor.verdict().code, io::EstimateStatus::Code::kDiverged);
   EXPECT_EQ(monitor.verdict().t_ns, 4'110'000'000);
+}
+
+// Exact binomial quantiles (by summing the probabilities):
+// P(X ≤ k) ≥ 0.999 first at k = 5, 13, 73, 188 for n = 20, 100, 1000, 3000, p = 0.05.
+TEST(HealthMonitorStage, BinomialQuantileIsExact) {
+  EXPECT_EQ(binomialQuantile(20, 0.05, 0.999), 5);
+  EXPECT_EQ(binomialQuantile(100, 0.05, 0.999), 13);
+  EXPECT_EQ(binomialQuantile(1000, 0.05, 0.999), 73);
+  EXPECT_EQ(binomialQuantile(3000, 0.05, 0.999), 188);
+  EXPECT_EQ(binomialQuantile(0, 0.05, 0.999), 0);
+}
+
+// Rejected innovations, however large, never make a run `diverged`: the
+// ratio is over the accepted ones. Updates of 10 features (20 dof accepted,
+// ρ = 1) and 1 rejected feature of NIS 1000 each: 100 updates in the 1 s
+// window judge 1100 features, 100 rejected against a bound of
+// binomialQuantile(1100, 0.05, 0.999) = 79, so `degraded` with the gated-out
+// cause, first when the window's rejected count exceeds its bound: at update
+// 31 (32 rejected of 352, bound 31).
+TEST(HealthMonitorStage, GatedOutFeaturesAreDegradedNeverDiverged) {
+  ASSERT_EQ(binomialQuantile(1100, 0.05, 0.999), 79);
+  HealthMonitor monitor(healthOptions());
+  std::vector<Estimate> out;
+  int first_degraded = -1;
+  for (int k = 0; k < 300; ++k) {
+    Estimate e = update(k, 20.0, 20, 10);
+    e.innovation.rejected = 1;
+    e.innovation.nis += 1000.0;
+    e.innovation.dof += 2;
+    monitor.process(e, out);
+    if (first_degraded < 0 && monitor.verdict().code != io::EstimateStatus::Code::kOk) first_degraded = k;
+  }
+  EXPECT_EQ(monitor.verdict().code, io::EstimateStatus::Code::kDegraded);
+  EXPECT_NE(monitor.verdict().cause.find("gated out"), std::string::npos) << monitor.verdict().cause;
+  long expected = -1;
+  for (int k = 0; k < 300 && expected < 0; ++k)
+    if (k + 1 > binomialQuantile(11L * (k + 1), 0.05, 0.999)) expected = k;
+  EXPECT_EQ(expected, 31);
+  EXPECT_EQ(first_degraded, expected);
+  EXPECT_EQ(monitor.verdict().t_ns, static_cast<TimeNs>(expected) * 10'000'000);
+
+  // One rejected feature in 100 updates of 10: within a consistent filter's share.
+  HealthMonitor calm(healthOptions());
+  for (int k = 0; k < 300; ++k) {
+    Estimate e = update(k, 20.0, 20, 10);
+    e.innovation.rejected = k % 100 == 0 ? 1 : 0;
+    calm.process(e, out);
+  }
+  EXPECT_EQ(calm.verdict().code, io::EstimateStatus::Code::kOk);
+}
+
+// health.txt keeps the accepted part of the innovations; a file from before
+// those two columns reads as if every innovation had been accepted.
+TEST(HealthMonitorStage, HealthTextRoundTripsAndReadsTheOlderFormat) {
+  test::TempDir dir;
+  const std::string path = dir.file("health.txt");
+  {
+    io::HealthWriter w(path);
+    w.append(io::HealthRow{1'000'000'000, 30.5, 24, 10, 2, 7, 3, 0.25, 20.25, 20});
+    w.close();
+  }
+  const auto rows = io::readHealthText(path);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].nis_accepted, 20.25);
+  EXPECT_EQ(rows[0].dof_accepted, 20);
+  EXPECT_EQ(rows[0].rejected, 2);
+  const std::string old_path = dir.file("old_health.txt");
+  {
+    std::FILE* f = std::fopen(old_path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("# t nis dof accepted rejected slam msckf sigma_p_m\n1.0 30.5 24 10 2 7 3 0.25\n", f);
+    std::fclose(f);
+  }
+  const auto old_rows = io::readHealthText(old_path);
+  ASSERT_EQ(old_rows.size(), 1u);
+  EXPECT_EQ(old_rows[0].nis_accepted, 30.5);
+  EXPECT_EQ(old_rows[0].dof_accepted, 24);
 }
 
 TEST(HealthMonitorStage, StarvationAndCovarianceGrowthAreDegraded) {

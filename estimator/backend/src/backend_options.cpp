@@ -10,6 +10,7 @@ void BackendOptions::validate() const {
   // Upper bounds on sizes keep a typo from exhausting memory or time: the state
   // grows by 6 per window pose and 3 per SLAM feature, its covariance quadratically.
   requireField(window_size >= 2 && window_size <= 200, "window_size", "must be in [2, 200]");
+  requireInRange("keyframe_interval_s", keyframe_interval_s, 0.0, 10.0);
   requireField(max_slam_features >= 0 && max_slam_features <= 1000, "max_slam_features", "must be in [0, 1000]");
   requirePositive("sigma_img_px", sigma_img_px);
   requireNonNegative("sigma_img_normalized", sigma_img_normalized);

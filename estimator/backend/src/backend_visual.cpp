@@ -1,6 +1,7 @@
 // The visual update of Backend: one measurement set (backend.h, steps 1-6),
 // each step one function.
 #include <algorithm>
+#include <optional>
 #include <unordered_set>
 
 #include "evio/estimator/backend/backend.h"
@@ -26,7 +27,8 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
                          static_cast<int>(slam_gate.gated_out.size());
   const std::vector<FeatureId> slam_candidates =
       chooseSlamCandidates(tracks_, clone_id, free_slots, options_.slam_min_track_length);
-  const bool sliding = static_cast<int>(state_.clones.size()) > options_.window_size;
+  const std::optional<std::size_t> leaving = cloneToMarginalize();
+  const bool sliding = leaving == std::size_t{0};  // tracks losing their oldest observation go to the MSCKF
   const MsckfChoice msckf_choice = chooseMsckfTracks(
       tracks_, clone_id, state_.clones.front().id, sliding,
       std::unordered_set<FeatureId>(slam_candidates.begin(), slam_candidates.end()), options_.msckf_min_track_length,
@@ -41,7 +43,7 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
   slam_.prune(slam_gate.gated_out);
   if (!slam_.initialize(slam_candidates, &tracks_))
     setStatus(BackendStatus::Code::kDiverged, "innovation covariance not positive definite");
-  if (static_cast<int>(state_.clones.size()) > options_.window_size) slideWindow();
+  if (leaving) marginalizeClone(*leaving);
   estimates_.push_back(makeEstimate());
 }
 
@@ -71,11 +73,21 @@ bool Backend::stackedUpdate(const std::vector<FeatureObservation>& slam_observat
                            options_.iekf_iterations, options_.joseph_form);
 }
 
-void Backend::slideWindow() {
-  const std::int64_t oldest = state_.clones.front().id;
+std::optional<std::size_t> Backend::cloneToMarginalize() const {
+  const std::size_t n = state_.clones.size();
+  if (n >= 3) {
+    const TimeNs spacing = state_.clones[n - 2].t_ns - state_.clones[n - 3].t_ns;
+    if (nsToSeconds(spacing) < options_.keyframe_interval_s) return n - 2;
+  }
+  if (static_cast<int>(n) > options_.window_size) return 0;
+  return std::nullopt;
+}
+
+void Backend::marginalizeClone(std::size_t i) {
+  const std::int64_t leaving = state_.clones[i].id;
   const std::size_t newest = state_.clones.size() - 1;
   for (std::size_t j = state_.features.size(); j-- > 0;) {
-    if (state_.features[j].anchor_clone_id != oldest) continue;
+    if (state_.features[j].anchor_clone_id != leaving) continue;
     const VecX n = state_.yawDirection(fej_imu_);
     if (reanchorSlamFeature(state_, j, newest, options_.observability_constraint ? &n : nullptr)) {
       ++stats_.slam_reanchored;
@@ -86,11 +98,11 @@ void Backend::slideWindow() {
   }
   for (auto it = tracks_.begin(); it != tracks_.end();) {
     auto& o = it->second.observations;
-    o.erase(std::remove_if(o.begin(), o.end(), [oldest](const TrackObservation& x) { return x.clone_id == oldest; }),
+    o.erase(std::remove_if(o.begin(), o.end(), [leaving](const TrackObservation& x) { return x.clone_id == leaving; }),
             o.end());
     it = o.empty() ? tracks_.erase(it) : std::next(it);
   }
-  state_.removeClone(0);
+  state_.removeClone(i);
 }
 
 }  // namespace evio::estimator

@@ -33,6 +33,7 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
   if (rotationCompensatedDisparity(clones, z) < min_parallax) return MsckfOutcome::kNoParallax;
   TriangulationResult tri;
   if (!triangulateFeature(clones, z, n - 1, triangulation, &tri)) return MsckfOutcome::kTriangulationFailed;
+  if (!knowsDepth(tri, triangulation)) return MsckfOutcome::kNoParallax;
 
   const Eigen::Index m = 2 * static_cast<Eigen::Index>(n);
   MatX H_x = MatX::Zero(m, state.dim());

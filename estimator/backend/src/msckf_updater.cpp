@@ -1,5 +1,6 @@
 #include "evio/estimator/backend/msckf_updater.h"
 
+#include <cmath>
 #include <utility>
 
 #include "evio/estimator/backend/msckf_update.h"
@@ -7,7 +8,7 @@
 namespace evio::estimator {
 
 UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* tracks) {
-  const TriangulationOptions tri = triangulationOptions();
+  const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_));
   const double min_parallax = minParallaxNormalized(camera_);
   std::vector<MsckfResidual> used;
   for (const FeatureId id : ids) {

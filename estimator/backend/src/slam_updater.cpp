@@ -98,9 +98,10 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, bool* done) 
   std::vector<std::size_t> positions;
   std::vector<Vec2> z;
   gatherTrack(state(), track, &clones, &positions, &z);
+  const TriangulationOptions tri = triangulationOptions(sigma_z_);
   TriangulationResult res;
   if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) < minParallaxNormalized(camera_) ||
-      !triangulateFeature(clones, z, clones.size() - 1, triangulationOptions(), &res))
+      !triangulateFeature(clones, z, clones.size() - 1, tri, &res) || !knowsDepth(res, tri))
     return true;
   const SlamInitOutcome outcome =
       addSlamFeatureTriangulated(state(), track, res.abr, sigma_z_ * sigma_z_, options().joseph_form, *msckf_chi2_,

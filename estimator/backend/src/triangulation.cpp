@@ -4,10 +4,25 @@
 #include <algorithm>
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 
 #include "evio/estimator/backend/visual_models.h"
 
 namespace evio::estimator {
+
+namespace {
+/// √[(JᵀJ)⁻¹]_ρρ, the σ of ρ per unit observation noise; infinity when JᵀJ
+/// is singular (no baseline). [(JᵀJ)⁻¹]_ρρ = 1 / (Schur complement of the
+/// bearing block), which stays finite where the full inverse would not.
+double inverseDepthSigma(const Mat3& JtJ) {
+  const Eigen::Matrix2d A = JtJ.topLeftCorner<2, 2>();
+  const Eigen::Vector2d b = JtJ.topRightCorner<2, 1>();
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt(A);
+  if (ldlt.info() != Eigen::Success || !(A.determinant() > 0.0)) return std::numeric_limits<double>::infinity();
+  const double schur = JtJ(2, 2) - b.dot(ldlt.solve(b));
+  return schur > 0.0 ? 1.0 / std::sqrt(schur) : std::numeric_limits<double>::infinity();
+}
+}  // namespace
 
 bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z, std::size_t anchor,
                         const TriangulationOptions& options, TriangulationResult* result) {
@@ -56,7 +71,7 @@ bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vecto
       break;
     }
   }
-  if (!evaluate(abr, false)) return false;
+  if (!evaluate(abr, true)) return false;
   const double rho = abr.z();
   if (!(rho > 0.0) || 1.0 / rho > options.max_depth_m) return false;
   const Vec3 p_W = anchoredToWorld(clones[anchor], abr);
@@ -68,8 +83,13 @@ bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vecto
   result->p_W = p_W;
   result->iterations = it;
   result->rms_residual = std::sqrt(r.squaredNorm() / static_cast<double>(n));
+  result->sigma_rho_unit = inverseDepthSigma(J.transpose() * J);
   if (options.max_rms_residual > 0.0 && result->rms_residual > options.max_rms_residual) return false;
   return true;
+}
+
+bool knowsDepth(const TriangulationResult& result, const TriangulationOptions& options) {
+  return !(options.max_sigma_rho > 0.0) || options.sigma_z * result.sigma_rho_unit <= options.max_sigma_rho;
 }
 
 double rotationCompensatedDisparity(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z) {

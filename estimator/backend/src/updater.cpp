@@ -23,6 +23,10 @@ bool Updater::passesRecordedGate(const MatX& H, const VecX& r, double sigma2, do
     if (std::isfinite(m)) {
       s->nis += m;
       s->dof += static_cast<int>(r.size());
+      if (pass) {
+        s->nis_accepted += m;
+        s->dof_accepted += static_cast<int>(r.size());
+      }
     }
     ++(pass ? s->accepted : s->rejected);
   }
@@ -34,11 +38,15 @@ bool Updater::constrainAndUpdate(MatX H, const VecX& r, double sigma2) const {
   return ekfUpdate(state(), H, r, sigma2, options().joseph_form);
 }
 
-TriangulationOptions Updater::triangulationOptions() const {
+TriangulationOptions Updater::triangulationOptions(double sigma_z) const {
   TriangulationOptions t;
   t.max_iterations = options().triangulation_max_iterations;
   t.tolerance = options().triangulation_tolerance;
   t.min_depth_m = options().triangulation_min_depth_m;
+  if (options().triangulate_when_better_than_prior) {
+    t.sigma_z = sigma_z;
+    t.max_sigma_rho = 1.0 / (4.0 * options().slam_min_depth_m);  // the depth prior's σ_ρ0
+  }
   return t;
 }
 

@@ -44,7 +44,7 @@ EstimateWriter::EstimateWriter(std::string folder, const PipelineOutputOptions& 
   timing_ = std::make_unique<io::TimingWriter>(path("timing.txt"));
   if (options_.health) {
     std::vector<std::string> h = header_;
-    h.push_back("innovations of each visual update; t nis dof accepted rejected slam msckf sigma_p_m");
+    h.push_back("innovations of each visual update; t nis dof accepted rejected slam msckf sigma_p_m nis_accepted dof_accepted");
     health_ = std::make_unique<io::HealthWriter>(path("health.txt"), h);
   }
 }

@@ -109,6 +109,8 @@ struct InnovationStats {
   int dof = 0;            ///< Σ residual dimensions
   int accepted = 0;       ///< features the gates let into the update
   int rejected = 0;       ///< features the gates turned away
+  double nis_accepted = 0.0;  ///< the part of nis from the accepted features
+  int dof_accepted = 0;       ///< the part of dof from the accepted features
 };
 
 /// The filter's estimate at one time, with the covariances the writer reports.

@@ -18,14 +18,17 @@
 ///   2. SLAM features observed in the set give 2 residuals each
 ///      (Mahalanobis-gated); SLAM features not observed are marginalised;
 ///   3. MSCKF features: tracks about to lose their oldest observation as the
-///      window slides (and lost tracks when msckf_use_lost_tracks) with enough
-///      parallax, triangulated, null-space projected and χ²-gated;
+///      window slides (and lost tracks when msckf_use_lost_tracks) whose
+///      triangulation fixes the depth, null-space projected and χ²-gated;
 ///   4. one stacked, QR-compressed EKF update of 2 and 3;
 ///   5. free SLAM slots are filled with the longest live tracks of at least
 ///      slam_min_track_length observations: from triangulation when the
-///      parallax test passes, else with the depth prior;
-///   6. when the window exceeds M poses, SLAM features anchored on the oldest
-///      pose are re-anchored on the newest and the oldest pose is marginalised.
+///      track fixes the inverse depth better than the depth prior
+///      (triangulate_when_better_than_prior), else with the depth prior;
+///   6. the previous newest pose is marginalised when it is not a keyframe
+///      (closer than keyframe_interval_s to the pose before it), else the
+///      oldest when the window exceeds M poses; SLAM features anchored on the
+///      marginalised pose are re-anchored on the newest.
 ///
 /// Divergence (non-finite state, covariance with a non-positive variance or not
 /// positive semi-definite — cloning makes it singular by construction — velocity
@@ -120,7 +123,13 @@ class Backend {
   /// observations and the MSCKF rows; false when it failed.
   bool stackedUpdate(const std::vector<FeatureObservation>& slam_observations, const UpdateRows& msckf_rows,
                      std::size_t c);
-  void slideWindow();
+  /// The clone that leaves the window after this set's update, if any: the
+  /// previous newest when it is closer than keyframe_interval_s to the one
+  /// before it (not a keyframe), else the oldest once the window is full.
+  std::optional<std::size_t> cloneToMarginalize() const;
+  /// Removes clone i: SLAM features anchored on it are re-anchored on the
+  /// newest clone, the tracks' observations in it are dropped.
+  void marginalizeClone(std::size_t i);
 
   void checkHealth();
   void setStatus(BackendStatus::Code code, const std::string& cause);

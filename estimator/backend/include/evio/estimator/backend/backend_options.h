@@ -18,6 +18,15 @@ namespace evio::estimator {
 struct BackendOptions {
   // Sliding window and features -----------------------------------------------
   int window_size = 10;        ///< M: camera poses in the sliding window
+  /// Keyframe spacing of the window, s: the pose cloned for a measurement set
+  /// stays in the window only if it is at least this much later than the
+  /// clone before it; otherwise it is marginalised when the next set arrives
+  /// (its SLAM updates are kept, its MSCKF observations dropped). Frames at
+  /// 20–22 Hz are all kept; event-based frontends, which update at 100–500
+  /// Hz, get a window of the same span in time, so that MSCKF features and
+  /// triangulated SLAM features have parallax (docs/algorithms.md#keyframe-window).
+  /// 0: every measurement set's pose is kept (xVIO).
+  double keyframe_interval_s = 0.04;
   int max_slam_features = 15;  ///< N: SLAM features in the state
   /// Image measurement noise σ_img in pixels, converted to normalised units by
   /// the mean focal length (σ_img / f). xVIO's 0.025 normalised ≈ 5 px at f ≈ 200 px.
@@ -55,7 +64,7 @@ struct BackendOptions {
   int slam_min_track_length = 10;          ///< observations before a track may become SLAM
   double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
   int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature
-  bool slam_triangulated_init = true;      ///< initialise from triangulation when the parallax test passes
+  bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// Add the covariance of the bilinear ρ·(clone error) term that the EKF's
   /// linearisation drops to each SLAM observation's noise
   /// (slamSecondOrderCovariance in slam_features.h): the inflation is large
@@ -68,7 +77,17 @@ struct BackendOptions {
   /// Also use tracks lost before spanning the window (xVIO drops them).
   bool msckf_use_lost_tracks = false;
   int msckf_min_track_length = 3;          ///< fewer observations: not used (>= 2)
-  double min_parallax_px = 30.0;           ///< rotation-compensated disparity for triangulation, px
+  /// Rotation-compensated disparity a track needs before it is triangulated,
+  /// px. xVIO's 30 px kept MSCKF features and triangulated SLAM features out
+  /// of every scene farther than about 1 m; below 10 px the backend's NEES
+  /// test finds the filter overconfident (docs/algorithms.md#triangulation).
+  double min_parallax_px = 10.0;
+  /// Triangulate a track (MSCKF update, triangulated SLAM initialisation) only
+  /// when its own observations fix the inverse depth better than the depth
+  /// prior: σ_ρ from the triangulation (σ_img per coordinate) at most
+  /// σ_ρ0 = 1/(4 d_min); otherwise an MSCKF track counts as without parallax
+  /// and a SLAM feature takes the depth prior.
+  bool triangulate_when_better_than_prior = true;
   double msckf_gate_probability = 0.95;    ///< χ² gate of MSCKF features
   int triangulation_max_iterations = 10;   ///< Gauss–Newton iterations
   double triangulation_tolerance = 1e-5;   ///< relative step that ends Gauss–Newton
@@ -130,6 +149,8 @@ struct BackendOptions {
   template <class V>
   void fields(V& v) {
     v("window_size", window_size, "M: camera poses in the sliding window");
+    v("keyframe_interval_s", keyframe_interval_s,
+      "a cloned pose closer than this to the one before it leaves the window at the next set, s (0: keep all)");
     v("max_slam_features", max_slam_features, "N: SLAM features in the state");
     v("sigma_img_px", sigma_img_px, "image measurement noise, px");
     v("sigma_img_normalized", sigma_img_normalized, "if > 0: image noise in normalised units (replaces sigma_img_px)");
@@ -156,6 +177,8 @@ struct BackendOptions {
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
     v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");
     v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for triangulation, px");
+    v("triangulate_when_better_than_prior", triangulate_when_better_than_prior,
+      "triangulate only tracks whose inverse depth sigma is below the depth prior's");
     v("msckf_gate_probability", msckf_gate_probability, "MSCKF chi2 gate probability");
     v("triangulation_max_iterations", triangulation_max_iterations, "Gauss-Newton iterations");
     v("triangulation_tolerance", triangulation_tolerance, "relative Gauss-Newton step tolerance");

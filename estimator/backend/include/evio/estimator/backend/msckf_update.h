@@ -32,7 +32,9 @@ void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vecto
                  std::vector<Mat2>* whiten = nullptr);
 
 /// The null-space projected MSCKF residual of `track`. min_parallax is the
-/// rotation-compensated disparity (normalised units) the track must exceed.
+/// rotation-compensated disparity (normalised units) the track must exceed;
+/// a triangulation that fails knowsDepth(·, triangulation) counts as
+/// kNoParallax too.
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
                            const TriangulationOptions& triangulation, MsckfResidual* out);
 

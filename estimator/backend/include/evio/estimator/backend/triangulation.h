@@ -8,6 +8,10 @@
 /// 2. Gauss–Newton on the anchored inverse-depth parameters (α, β, ρ) of the
 ///    anchor clone, minimising Σ_i ‖z_i − π(h_i(α, β, ρ))‖² (visual_models.h),
 ///    stopping when the step is below tolerance · ‖(α, β, ρ)‖.
+/// 3. The inverse depth's standard deviation from the observations alone,
+///    σ_ρ = σ_z √[(JᵀJ)⁻¹]_ρρ with J the Jacobian at the solution and σ_z one
+///    observation's noise: how much the track itself says about the depth
+///    (infinite without baseline, e.g. in rotation-only motion).
 
 #include <vector>
 
@@ -24,6 +28,10 @@ struct TriangulationOptions {
   /// Residual bound: the RMS reprojection error after convergence must be
   /// below this, in normalised units (0: no bound).
   double max_rms_residual = 0.0;
+  /// For knowsDepth(): one observation's noise σ_z (normalised units) and the
+  /// largest σ of ρ a usable triangulation may have, 1/m (0: no bound).
+  double sigma_z = 0.0;
+  double max_sigma_rho = 0.0;
 };
 
 struct TriangulationResult {
@@ -31,6 +39,9 @@ struct TriangulationResult {
   Vec3 p_W = Vec3::Zero();  ///< the same point in W
   int iterations = 0;
   double rms_residual = 0.0;  ///< normalised units
+  /// σ of ρ from the observations alone for a noise of 1 normalised unit per
+  /// coordinate (multiply by σ_z), 1/m; infinity when ρ is unobservable.
+  double sigma_rho_unit = 0.0;
 };
 
 /// Triangulates from observations z[i] in clones[i] (at least 2), anchored in
@@ -38,6 +49,11 @@ struct TriangulationResult {
 /// degenerate, the point is behind or too near/far, or GN diverges.
 bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
                         std::size_t anchor, const TriangulationOptions& options, TriangulationResult* result);
+
+/// Whether the track's observations fix the inverse depth to within
+/// options.max_sigma_rho: σ_z · sigma_rho_unit ≤ max_sigma_rho (always true
+/// when max_sigma_rho is 0).
+bool knowsDepth(const TriangulationResult& result, const TriangulationOptions& options);
 
 /// Rotation-compensated disparity of a track (docs/algorithms.md#triangulation, the parallax test):
 /// the largest distance, in normalised units, between the observation in the

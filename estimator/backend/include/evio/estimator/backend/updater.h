@@ -62,7 +62,9 @@ class Updater {
   bool constrainAndUpdate(MatX H, const VecX& r, double sigma2) const;
 
   /// The triangulation settings of the options (MSCKF features and SLAM initialisation).
-  TriangulationOptions triangulationOptions() const;
+  /// The triangulation settings; sigma_z: σ of one normalised image
+  /// coordinate (for the information test, knowsDepth).
+  TriangulationOptions triangulationOptions(double sigma_z) const;
   /// min_parallax_px in normalised units: divided by the mean focal length of `camera`.
   double minParallaxNormalized(const Camera& camera) const;
 

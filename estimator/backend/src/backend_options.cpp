@@ -33,6 +33,7 @@ void BackendOptions::validate() const {
   requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");
   requireField(msckf_min_track_length >= 2, "msckf_min_track_length", "must be >= 2");
   requireNonNegative("min_parallax_px", min_parallax_px);
+  requireNonNegative("slam_min_parallax_px", slam_min_parallax_px);
   requireField(msckf_gate_probability > 0.0 && msckf_gate_probability < 1.0, "msckf_gate_probability",
                "must be in (0, 1)");
   requireField(triangulation_max_iterations >= 1 && triangulation_max_iterations <= 1000, "triangulation_max_iterations",

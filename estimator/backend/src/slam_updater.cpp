@@ -86,21 +86,23 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
     if (it == tracks->end() || it->second.observations.empty()) continue;
     const FeatureTrack track = it->second;
     tracks->erase(it);
+    const DepthPrior prior = depthPrior(state().clones[c], track.observations.back().z);
     bool done = false;
-    if (options().slam_triangulated_init && !initializeTriangulated(track, &done)) return false;
-    if (!done) initializeWithPrior(track, c);
+    if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) return false;
+    if (!done) initializeWithPrior(track, c, prior);
   }
   return true;
 }
 
-bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, bool* done) {
+bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, double prior_sigma_rho, bool* done) {
   std::vector<CameraClone> clones;
   std::vector<std::size_t> positions;
   std::vector<Vec2> z;
   gatherTrack(state(), track, &clones, &positions, &z);
-  const TriangulationOptions tri = triangulationOptions(sigma_z_);
+  TriangulationOptions tri = triangulationOptions(sigma_z_);
+  if (tri.max_sigma_rho > 0.0) tri.max_sigma_rho = prior_sigma_rho;  // better than the prior this feature would take
   TriangulationResult res;
-  if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) < minParallaxNormalized(camera_) ||
+  if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) < minParallaxNormalized(camera_, options().slam_min_parallax_px) ||
       !triangulateFeature(clones, z, clones.size() - 1, tri, &res) || !knowsDepth(res, tri))
     return true;
   const SlamInitOutcome outcome =
@@ -112,19 +114,17 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, bool* done) 
   return true;
 }
 
-void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c) {
+SlamUpdater::DepthPrior SlamUpdater::depthPrior(const CameraClone& clone, const Vec2& z) const {
+  if (const auto rho = rangeDepthPrior(clone, z)) return {*rho, options().range_prior_relative_sigma * *rho, true};
+  // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min).
+  return {1.0 / (2.0 * options().slam_min_depth_m), 1.0 / (4.0 * options().slam_min_depth_m), false};
+}
+
+void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior) {
   const Vec2& z = track.observations.back().z;
   const Mat2& W = track.observations.back().whiten;
-  if (const auto rho = rangeDepthPrior(state().clones[c], z)) {
-    addSlamFeatureWithPrior(state(), track.id, c, z, *rho, options().range_prior_relative_sigma * *rho, sigma_z_, W);
-    ++stats().slam_initialized_range;
-    return;
-  }
-  // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min).
-  const double rho0 = 1.0 / (2.0 * options().slam_min_depth_m);
-  const double sigma_rho0 = 1.0 / (4.0 * options().slam_min_depth_m);
-  addSlamFeatureWithPrior(state(), track.id, c, z, rho0, sigma_rho0, sigma_z_, W);
-  ++stats().slam_initialized_prior;
+  addSlamFeatureWithPrior(state(), track.id, c, z, prior.rho, prior.sigma, sigma_z_, W);
+  ++(prior.from_range ? stats().slam_initialized_range : stats().slam_initialized_prior);
 }
 
 std::optional<double> SlamUpdater::rangeDepthPrior(const CameraClone& clone, const Vec2& z) const {

@@ -50,9 +50,9 @@ TriangulationOptions Updater::triangulationOptions(double sigma_z) const {
   return t;
 }
 
-double Updater::minParallaxNormalized(const Camera& camera) const {
+double Updater::minParallaxNormalized(const Camera& camera, double parallax_px) const {
   const Vec4 k = camera.intrinsics();
-  return options().min_parallax_px / (0.5 * (k(0) + k(1)));
+  return parallax_px / (0.5 * (k(0) + k(1)));
 }
 
 }  // namespace evio::estimator

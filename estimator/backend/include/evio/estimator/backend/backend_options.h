@@ -77,16 +77,21 @@ struct BackendOptions {
   /// Also use tracks lost before spanning the window (xVIO drops them).
   bool msckf_use_lost_tracks = false;
   int msckf_min_track_length = 3;          ///< fewer observations: not used (>= 2)
-  /// Rotation-compensated disparity a track needs before it is triangulated,
-  /// px. xVIO's 30 px kept MSCKF features and triangulated SLAM features out
-  /// of every scene farther than about 1 m; below 10 px the backend's NEES
-  /// test finds the filter overconfident (docs/algorithms.md#triangulation).
+  /// Rotation-compensated disparity an MSCKF track needs before it is
+  /// triangulated, px. xVIO's 30 px kept MSCKF features out of every scene
+  /// farther than about 1 m (docs/algorithms.md#triangulation).
   double min_parallax_px = 10.0;
+  /// The same for a SLAM feature's triangulated initialisation, px (xVIO's
+  /// 30): below it the backend's NEES test finds the filter overconfident
+  /// (a wrongly triangulated SLAM feature stays in the state; an MSCKF
+  /// feature is used once).
+  double slam_min_parallax_px = 30.0;
   /// Triangulate a track (MSCKF update, triangulated SLAM initialisation) only
   /// when its own observations fix the inverse depth better than the depth
-  /// prior: σ_ρ from the triangulation (σ_img per coordinate) at most
-  /// σ_ρ0 = 1/(4 d_min); otherwise an MSCKF track counts as without parallax
-  /// and a SLAM feature takes the depth prior.
+  /// prior: σ_ρ from the triangulation (σ_img per coordinate) at most the
+  /// σ of the prior the feature would take (the range finder's, else
+  /// σ_ρ0 = 1/(4 d_min)); otherwise an MSCKF track counts as without
+  /// parallax and a SLAM feature takes the depth prior.
   bool triangulate_when_better_than_prior = true;
   double msckf_gate_probability = 0.95;    ///< χ² gate of MSCKF features
   int triangulation_max_iterations = 10;   ///< Gauss–Newton iterations
@@ -176,7 +181,8 @@ struct BackendOptions {
       "SLAM observation noise includes the second-order inverse-depth term");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
     v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");
-    v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for triangulation, px");
+    v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for an MSCKF triangulation, px");
+    v("slam_min_parallax_px", slam_min_parallax_px, "rotation-compensated disparity for a triangulated SLAM initialisation, px");
     v("triangulate_when_better_than_prior", triangulate_when_better_than_prior,
       "triangulate only tracks whose inverse depth sigma is below the depth prior's");
     v("msckf_gate_probability", msckf_gate_probability, "MSCKF chi2 gate probability");

@@ -51,8 +51,18 @@ class SlamUpdater : public Updater {
   bool initialize(const std::vector<FeatureId>& candidates, TrackMap* tracks);
 
  private:
-  bool initializeTriangulated(const FeatureTrack& track, bool* done);
-  void initializeWithPrior(const FeatureTrack& track, std::size_t c);
+  /// The inverse-depth prior a new feature observed at z in clone c takes:
+  /// from the range finder when it gives one, else the fixed prior.
+  struct DepthPrior {
+    double rho = 0.0;    ///< 1/m
+    double sigma = 0.0;  ///< 1/m
+    bool from_range = false;
+  };
+  DepthPrior depthPrior(const CameraClone& clone, const Vec2& z) const;
+  /// Triangulated initialisation when the track fixes ρ better than the
+  /// prior it would otherwise take (prior_sigma_rho, 1/m).
+  bool initializeTriangulated(const FeatureTrack& track, double prior_sigma_rho, bool* done);
+  void initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior);
   /// ρ0 of a feature seen at normalised z from `clone`, from the latest range
   /// reading (BackendOptions::range_prior_relative_sigma); nullopt when there
   /// is none or the ray does not meet the level plane in front of the camera.

@@ -65,8 +65,8 @@ class Updater {
   /// The triangulation settings; sigma_z: σ of one normalised image
   /// coordinate (for the information test, knowsDepth).
   TriangulationOptions triangulationOptions(double sigma_z) const;
-  /// min_parallax_px in normalised units: divided by the mean focal length of `camera`.
-  double minParallaxNormalized(const Camera& camera) const;
+  /// A parallax in px in normalised units: divided by the mean focal length of `camera`.
+  double minParallaxNormalized(const Camera& camera, double parallax_px) const;
 
   FilterState& state() const { return *ctx_.state; }
   const BackendOptions& options() const { return *ctx_.options; }

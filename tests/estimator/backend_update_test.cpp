@@ -36,6 +36,17 @@ std::vector<CameraClone> arcOfClones(int n, std::uint64_t seed, double baseline_
   return out;
 }
 
+/// The exact projections of p_W in every clone (fewer when one fails).
+std::vector<Vec2> exactObservations(const std::vector<CameraClone>& clones, const Vec3& p_W) {
+  std::vector<Vec2> z;
+  for (const CameraClone& c : clones) {
+    Vec2 zi;
+    if (!projectWorldPoint(c, p_W, &zi)) break;
+    z.push_back(zi);
+  }
+  return z;
+}
+
 FilterState stateWith(const std::vector<CameraClone>& clones, std::uint64_t seed) {
   RandomStream rng(seed, "cov");
   FilterState s;
@@ -108,12 +119,8 @@ TEST(BackendTriangulation, RotationCompensatedDisparity) {
 TEST(BackendTriangulation, InverseDepthSigmaIsTheSpreadOfNoisyTriangulations) {
   const auto clones = arcOfClones(6, 11, 0.2);
   const Vec3 p(4.0, 0.3, -0.2);
-  std::vector<Vec2> z;
-  for (const auto& c : clones) {
-    Vec2 zi;
-    ASSERT_TRUE(projectWorldPoint(c, p, &zi));
-    z.push_back(zi);
-  }
+  const std::vector<Vec2> z = exactObservations(clones, p);
+  ASSERT_EQ(z.size(), clones.size());
   TriangulationResult exact;
   ASSERT_TRUE(triangulateFeature(clones, z, clones.size() - 1, TriangulationOptions{}, &exact));
   ASSERT_TRUE(std::isfinite(exact.sigma_rho_unit));
@@ -135,12 +142,8 @@ TEST(BackendTriangulation, InverseDepthSigmaIsTheSpreadOfNoisyTriangulations) {
 
   // Half the baseline: less information about the depth.
   const auto shorter = arcOfClones(6, 11, 0.1);
-  std::vector<Vec2> zs;
-  for (const auto& c : shorter) {
-    Vec2 zi;
-    ASSERT_TRUE(projectWorldPoint(c, p, &zi));
-    zs.push_back(zi);
-  }
+  const std::vector<Vec2> zs = exactObservations(shorter, p);
+  ASSERT_EQ(zs.size(), shorter.size());
   TriangulationResult near_baseline;
   ASSERT_TRUE(triangulateFeature(shorter, zs, shorter.size() - 1, TriangulationOptions{}, &near_baseline));
   EXPECT_GT(near_baseline.sigma_rho_unit, exact.sigma_rho_unit);

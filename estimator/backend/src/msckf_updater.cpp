@@ -8,7 +8,7 @@
 namespace evio::estimator {
 
 UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* tracks) {
-  const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_));
+  const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
   std::vector<MsckfResidual> used;
   for (const FeatureId id : ids) {

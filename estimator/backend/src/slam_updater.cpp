@@ -99,10 +99,10 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, double prior
   std::vector<std::size_t> positions;
   std::vector<Vec2> z;
   gatherTrack(state(), track, &clones, &positions, &z);
-  TriangulationOptions tri = triangulationOptions(sigma_z_);
-  if (tri.max_sigma_rho > 0.0) tri.max_sigma_rho = prior_sigma_rho;  // better than the prior this feature would take
+  const TriangulationOptions tri = triangulationOptions(sigma_z_, prior_sigma_rho);
+  const double min_parallax = minParallaxNormalized(camera_, options().slam_min_parallax_px);
   TriangulationResult res;
-  if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) < minParallaxNormalized(camera_, options().slam_min_parallax_px) ||
+  if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) < min_parallax ||
       !triangulateFeature(clones, z, clones.size() - 1, tri, &res) || !knowsDepth(res, tri))
     return true;
   const SlamInitOutcome outcome =
@@ -117,7 +117,7 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, double prior
 SlamUpdater::DepthPrior SlamUpdater::depthPrior(const CameraClone& clone, const Vec2& z) const {
   if (const auto rho = rangeDepthPrior(clone, z)) return {*rho, options().range_prior_relative_sigma * *rho, true};
   // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min).
-  return {1.0 / (2.0 * options().slam_min_depth_m), 1.0 / (4.0 * options().slam_min_depth_m), false};
+  return {1.0 / (2.0 * options().slam_min_depth_m), fixedDepthPriorSigma(), false};
 }
 
 void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior) {

@@ -38,14 +38,14 @@ bool Updater::constrainAndUpdate(MatX H, const VecX& r, double sigma2) const {
   return ekfUpdate(state(), H, r, sigma2, options().joseph_form);
 }
 
-TriangulationOptions Updater::triangulationOptions(double sigma_z) const {
+TriangulationOptions Updater::triangulationOptions(double sigma_z, double prior_sigma_rho) const {
   TriangulationOptions t;
   t.max_iterations = options().triangulation_max_iterations;
   t.tolerance = options().triangulation_tolerance;
   t.min_depth_m = options().triangulation_min_depth_m;
   if (options().triangulate_when_better_than_prior) {
     t.sigma_z = sigma_z;
-    t.max_sigma_rho = 1.0 / (4.0 * options().slam_min_depth_m);  // the depth prior's σ_ρ0
+    t.max_sigma_rho = prior_sigma_rho;
   }
   return t;
 }

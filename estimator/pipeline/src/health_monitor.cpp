@@ -32,8 +32,18 @@ io::HealthRow healthRow(const Estimate& e) {
   // monitor flags it and health.txt stays readable.
   const double sigma_p =
       std::isfinite(var_p) ? std::sqrt(std::max(var_p, 0.0)) : std::numeric_limits<double>::max();
-  return io::HealthRow{e.t_ns,     n.nis,   n.dof, n.accepted, n.rejected, e.num_slam_features, e.num_msckf_features,
-                       sigma_p,    n.nis_accepted, n.dof_accepted};
+  io::HealthRow row;
+  row.t_ns = e.t_ns;
+  row.nis = n.nis;
+  row.dof = n.dof;
+  row.accepted = n.accepted;
+  row.rejected = n.rejected;
+  row.slam = e.num_slam_features;
+  row.msckf = e.num_msckf_features;
+  row.sigma_p_m = sigma_p;
+  row.nis_accepted = n.nis_accepted;
+  row.dof_accepted = n.dof_accepted;
+  return row;
 }
 
 void HealthMonitor::process(Estimate& in, std::vector<Estimate>& out) {

@@ -62,9 +62,13 @@ class Updater {
   bool constrainAndUpdate(MatX H, const VecX& r, double sigma2) const;
 
   /// The triangulation settings of the options (MSCKF features and SLAM initialisation).
-  /// The triangulation settings; sigma_z: σ of one normalised image
-  /// coordinate (for the information test, knowsDepth).
-  TriangulationOptions triangulationOptions(double sigma_z) const;
+  /// The triangulation settings; for the information test (knowsDepth,
+  /// when triangulate_when_better_than_prior) sigma_z, the σ of one
+  /// normalised image coordinate, and prior_sigma_rho, the σ of the inverse-
+  /// depth prior the triangulation has to beat, 1/m.
+  TriangulationOptions triangulationOptions(double sigma_z, double prior_sigma_rho) const;
+  /// σ_ρ0 = 1/(4 d_min) of the fixed depth prior, 1/m.
+  double fixedDepthPriorSigma() const { return 1.0 / (4.0 * options().slam_min_depth_m); }
   /// A parallax in px in normalised units: divided by the mean focal length of `camera`.
   double minParallaxNormalized(const Camera& camera, double parallax_px) const;
 

@@ -145,6 +145,35 @@ TEST(EkltCost, AvxTemplateLookupMatchesTheSse2OneBitForBit) {
   EXPECT_EQ(compared, 2000);
 }
 
+// The single-precision sums (eight pixels per group) give the same bits
+// through the AVX and the baseline lanes, and agree with the double-precision
+// evaluation to single-precision accuracy: cost within 1e-5, JᵀJ and Jᵀr
+// within 1e-4 of their largest entry.
+TEST(EkltCost, SinglePrecisionSumsAreTheSameBitsOnEveryPathAndMatchDouble) {
+  Fixture f;
+  const EventArray events = test::generateEvents(f.tex, f.motion, test::Roi{30, 20, 75, 60}, 0.0, 0.2, 1e-3, 0.02);
+  const std::vector<float> m = eventBatch(events, 0.15, 0.2, f.x0);
+  EkltBatch single{&f.templ, m.data(), kP};
+  single.single_precision = true;
+  const EkltBatch twice{&f.templ, m.data(), kP};
+  for (const Vec4& p : {Vec4(0.1, 50.3, 39.6, 0.7), Vec4(-0.4, 49.2, 41.1, -2.5), Vec4(0.02, 52.7, 37.9, 2.9)}) {
+    EkltEvaluation avx, baseline, reference;
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, true, &avx));
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, false, &baseline));
+    ASSERT_TRUE(evaluateEklt(twice, p, true, &reference));
+    EXPECT_EQ(avx.cost, baseline.cost);
+    EXPECT_EQ(avx.abs_sum, baseline.abs_sum);
+    for (int r = 0; r < 4; ++r) {
+      EXPECT_EQ(avx.jtr[r], baseline.jtr[r]);
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(avx.jtj(r, c), baseline.jtj(r, c));
+    }
+    EXPECT_NEAR(avx.cost, reference.cost, 1e-5);
+    EXPECT_NEAR(avx.abs_sum, reference.abs_sum, 1e-5 * reference.abs_sum);
+    EXPECT_LT((avx.jtj - reference.jtj).cwiseAbs().maxCoeff(), 1e-4 * reference.jtj.cwiseAbs().maxCoeff());
+    EXPECT_LT((avx.jtr - reference.jtr).cwiseAbs().maxCoeff(), 1e-4 * reference.jtr.cwiseAbs().maxCoeff());
+  }
+}
+
 TEST(EkltCost, FeaturePositionInvertsTheWarp) {
   // With W(u) = R u + t, the centre c satisfies W(c − c_acc) = x0.
   const Vec2 c_acc(10.0, 20.0), x0(50.0, 60.0);
@@ -286,6 +315,11 @@ TEST(EkltSolver, LooseToleranceLmStaysWithinAHundredthOfAPixelOfCeres) {
     const EkltBatch batch{&f.templ, m.data(), kP};
     const Vec4 p0(-f.motion.omega_rad_s * ta, f.x0.x(), f.x0.y(), std::atan2(-9.0, 12.0) + 0.25);
     const EkltSolution fast = solveEkltLm(batch, p0, loose);
+    EkltBatch single = batch;
+    single.single_precision = true;
+    const EkltSolution fast_single = solveEkltLm(single, p0, loose);
+    EXPECT_LT((ekltFeaturePosition(fast_single.p, c_acc, f.x0) - ekltFeaturePosition(fast.p, c_acc, f.x0)).norm(), 1e-3)
+        << "batch " << k;
     const EkltSolution tight = solveEkltLm(batch, p0, {});
     const EkltSolution ceres = solveEkltCeres(batch, p0, {});
     EXPECT_LT((ekltFeaturePosition(fast.p, c_acc, f.x0) - ekltFeaturePosition(ceres.p, c_acc, f.x0)).norm(), 0.01)

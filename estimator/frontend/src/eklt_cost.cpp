@@ -1,6 +1,7 @@
 #include "evio/estimator/frontend/eklt_cost.h"
 
 #include "evio/core/cpu_features.h"
+#include "eklt_sums.h"
 
 #include <algorithm>
 #include <cmath>
@@ -193,13 +194,7 @@ inline bool warpInside(const GradientTemplate& templ, const WarpFrame& f, int P)
   return cx - r >= lo && cy - r >= lo && cx + r < hi && cy + r < hi;
 }
 
-/// The sums over the patch that evaluateEklt turns into cost, JᵀJ and Jᵀr.
-struct EkltSums {
-  double aa = 0.0, am = 0.0, abs_sum = 0.0;
-  double d[4][4] = {};  // D = Σ ∂a/∂pᵀ ∂a/∂p (upper triangle used)
-  Vec4 da_a = Vec4::Zero();
-  Vec4 da_m = Vec4::Zero();
-};
+using detail::EkltSums;
 
 #if defined(EVIO_EKLT_AVX)
 // evaluateEklt for a warp inside the crop, with the Jacobian, four patch
@@ -499,16 +494,19 @@ void sumPatch(const EkltBatch& batch, const WarpFrame& frame, bool with_jacobian
 
 }  // namespace
 
-bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out) {
+namespace {
+
+bool evaluateWith(const EkltBatch& batch, const Vec4& p, bool with_jacobian, bool avx, EkltEvaluation* out) {
   const WarpFrame frame(p);
   const bool inside = warpInside(*batch.templ, frame, batch.patch_size);
-  const bool avx = cpuHasAvx();
   EkltSums s;
+  if (batch.single_precision && with_jacobian && inside && batch.patch_size >= 8)
+    detail::sumPatchSingle(batch, detail::EkltWarp{frame.c, frame.s, frame.t, frame.w, frame.w_perp}, avx, &s);
 #if defined(EVIO_EKLT_AVX)
-  if (avx && with_jacobian && batch.patch_size >= 4)
+  else if (avx && with_jacobian && batch.patch_size >= 4)
     sumPatchAvx(batch, frame, inside, &s);
-  else
 #endif
+  else
     sumPatch(batch, frame, with_jacobian, inside, avx, &s);
   const double aa = s.aa;
   if (!(aa > 0.0) || !std::isfinite(aa)) return false;
@@ -528,6 +526,18 @@ bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, Ekl
   }
   return true;
 }
+
+}  // namespace
+
+bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out) {
+  return evaluateWith(batch, p, with_jacobian, cpuHasAvx(), out);
+}
+
+namespace detail {
+bool evaluateEkltPath(const EkltBatch& batch, const Vec4& p, bool avx, EkltEvaluation* out) {
+  return evaluateWith(batch, p, true, avx && cpuHasAvx(), out);
+}
+}  // namespace detail
 
 bool ekltResiduals(const EkltBatch& batch, const Vec4& p, VecX* r, MatX* d_r_d_p) {
   const int P = batch.patch_size;

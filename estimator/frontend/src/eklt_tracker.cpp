@@ -64,6 +64,8 @@ struct EkltTracker::Slot {
   double flow_angle = 0.0;     // φ
   Vec2 centre = Vec2::Zero();  // current position = accumulation centre of the batch
   TimeNs t_centre_ns = 0;
+  Vec2 velocity = Vec2::Zero();  // px/s between the last two track points
+  bool has_velocity = false;
   double offset_x = 0.0;       // h − centre: patch coordinate of an event = pixel + offset
   double offset_y = 0.0;
   std::vector<float> patch;    // P², polarity-weighted bilinear splats
@@ -96,9 +98,11 @@ EkltTracker::EkltTracker(const EkltOptions& options, const Camera& camera, std::
       width_(camera.width()),
       height_(camera.height()),
       half_((options.patch_size_px - 1) / 2),
-      // The warp rotates the patch (corner at h√2) and moves its centre by
-      // up to a few px per batch; 6 px more cover that and the bicubic taps.
-      template_radius_(static_cast<int>(std::ceil(half_ * std::sqrt(2.0))) + 6),
+      // The warp rotates the patch (corner at h√2) and its centre t drifts
+      // from x0 while a solve explores; 10 px more cover that and the
+      // bicubic taps for all but a few evaluations (with 6 px, 18 % of them
+      // needed the slower clamped lookup at the crop's border).
+      template_radius_(static_cast<int>(std::ceil(half_ * std::sqrt(2.0))) + 10),
       slots_(static_cast<std::size_t>(options.max_features)) {
   options_.validate();
   require(threads >= 1 && threads <= 256, "EkltTracker: threads must be in [1, 256]");
@@ -167,6 +171,7 @@ void EkltTracker::activate(int index, const Vec2& uv, TimeNs t_ns, double flow_a
   s.t_centre_ns = t_ns;
   s.flow_angle = wrapAngle(flow_angle);
   s.quality = 1.0;
+  s.has_velocity = false;
   resetPatch(s);
   // Initial batch size from the template seen along the initial flow.
   Part& part = partOf(index);
@@ -361,17 +366,21 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
   std::vector<float>& measured = part.measured;
   for (std::size_t k = 0; k < s.patch.size(); ++k) measured[k] = s.patch[k] * inv;
 
-  // Initial guess: the previous warp, with the centre moved to the gyro
-  // prediction when enabled: t = x0 − R(θ)(c_pred − c).
+  // Initial guess: the previous warp, with the centre moved to the
+  // prediction (the gyro's when enabled, else the feature's image velocity
+  // between its last two track points): t = x0 − R(θ)(c_pred − c).
   Vec2 predicted = s.centre;
   if (predictor_ && !predictor_->empty()) {
     if (auto uv = predictor_->predict(s.centre, s.t_centre_ns, t_mid)) predicted = *uv;
+  } else if (options_.velocity_prediction && s.has_velocity) {
+    predicted = s.centre + s.velocity * nsToSeconds(t_mid - s.t_centre_ns);
   }
   const double c = std::cos(s.theta);
   const double sn = std::sin(s.theta);
   const Vec2 d = predicted - s.centre;
   const Vec4 p0(s.theta, s.x0.x() - (c * d.x() - sn * d.y()), s.x0.y() - (sn * d.x() + c * d.y()), s.flow_angle);
-  const EkltBatch batch{&s.templ, measured.data(), options_.patch_size_px};
+  EkltBatch batch{&s.templ, measured.data(), options_.patch_size_px};
+  batch.single_precision = options_.single_precision;
   const std::optional<EkltSolution> solved = solveBatch(s, batch, p0, predicted, part.timing);
   if (!solved) {  // no solution the batch supports: drop its events, keep the feature where it was
     ++part.timing.batches_dropped;
@@ -391,6 +400,10 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
   s.theta = sol.p[0];
   s.flow_angle = wrapAngle(sol.p[3]);
   s.quality = sol.quality();
+  if (t_mid > s.t_centre_ns) {
+    s.velocity = (uv - s.centre) / nsToSeconds(t_mid - s.t_centre_ns);
+    s.has_velocity = true;
+  }
   s.centre = uv;
   s.t_centre_ns = t_mid;
   s.batch_size = batchSize(sol.abs_sum);

@@ -396,6 +396,8 @@ void PipelineRun::loop() {
       result_.cpu.eklt_optimisation_s = t->optimisation_s;
       result_.cpu.eklt_events_s = t->splattingS();
       result_.cpu.eklt_frames_s = t->frame_s;
+      result_.eklt = EkltSolverCounts{t->events_in_patches, t->optimisations, t->solver_iterations,
+                                      t->reversal_solves, t->batches_dropped};
     }
     result_.track_lag = frontend_->trackLag();
   }

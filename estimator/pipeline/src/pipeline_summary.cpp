@@ -41,6 +41,10 @@ std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions
   writer.write(r.cpu);
   out << YAML::Key << "backend" << YAML::Value;
   writer.write(r.backend);
+  if (r.eklt) {
+    out << YAML::Key << "eklt" << YAML::Value;
+    writer.write(*r.eklt);
+  }
   if (r.track_lag) {  // the model lag = a + tau |v| the synchroniser compensated at the end
     out << YAML::Key << "track_lag" << YAML::Value << YAML::BeginMap;
     emitSeconds(out, "a_px", r.track_lag->a_px);

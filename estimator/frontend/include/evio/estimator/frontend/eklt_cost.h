@@ -29,6 +29,11 @@ struct EkltBatch {
   const GradientTemplate* templ = nullptr;  ///< gradient of the initialisation frame
   const float* measured = nullptr;          ///< P×P row-major, unit L2 norm
   int patch_size = 0;                       ///< P (odd)
+  /// Evaluate the sums with the Jacobian in single precision, eight patch
+  /// pixels at a time, where the warp's lookups lie inside the template
+  /// (eklt_cost_single.cpp); the same bits on every x86-64 CPU. Else, and
+  /// without the Jacobian, double precision.
+  bool single_precision = false;
 };
 
 /// Cost and Gauss–Newton quantities at one parameter vector.
@@ -76,6 +81,9 @@ namespace detail {
 /// has it) or the SSE2 one. Both must give the same bits.
 bool ekltSampleHasAvx();
 void ekltSampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg, bool avx);
+/// For tests: evaluateEklt with the Jacobian through the AVX paths (`avx`
+/// and the CPU has it) or the baseline ones; both must give the same bits.
+bool evaluateEkltPath(const EkltBatch& batch, const Vec4& p, bool avx, EkltEvaluation* out);
 }  // namespace detail
 
 }  // namespace evio::estimator

@@ -120,6 +120,25 @@ struct PipelineStageCpu {
   }
 };
 
+/// EKLT's optimiser work (summary.yaml `eklt`): what the tracking's CPU
+/// time is spent on.
+struct EkltSolverCounts {
+  std::uint64_t events_in_patches = 0;  ///< (event, feature) splats
+  std::uint64_t optimisations = 0;      ///< solver runs (reversal solves included)
+  std::uint64_t solver_iterations = 0;  ///< cost evaluations with Jacobian, all runs
+  std::uint64_t reversal_solves = 0;    ///< second solves from the reversed flow direction
+  std::uint64_t batches_dropped = 0;    ///< batches without a plausible solution
+
+  template <class V>
+  void fields(V& v) {
+    v("events_in_patches", events_in_patches, "(event, feature) splats");
+    v("optimisations", optimisations, "solver runs, reversal solves included");
+    v("solver_iterations", solver_iterations, "solver iterations over all runs");
+    v("reversal_solves", reversal_solves, "second solves from the reversed flow direction");
+    v("batches_dropped", batches_dropped, "batches without a plausible solution");
+  }
+};
+
 /// What went through the chain (summary.yaml `counts`).
 struct PipelineCounts {
   std::uint64_t events = 0;            ///< events read
@@ -157,6 +176,7 @@ struct PipelineResult {
   /// The tracker's lag estimated from the frames at the end
   /// (frontend.track_lag.estimate; track_lag.h).
   std::optional<TrackLag> track_lag;
+  std::optional<EkltSolverCounts> eklt;  ///< EKLT-VIO only
   std::vector<std::string> notes;  ///< degraded modes and choices made (one line each)
 };
 

@@ -1,0 +1,62 @@
+// The EKLT cost's sums with the Jacobian in single precision, eight patch
+// pixels per group (eklt_sums.h sumPatchSingle).
+//
+// The arithmetic is written once with GCC vector types of eight floats and
+// compiled twice: for AVX (one 256-bit register per vector) and for the
+// x86-64 baseline (two SSE registers per vector). Either way every lane
+// sees the same IEEE single-precision operations in the same order (the
+// build forbids FMA contraction), so both paths give the same bits. Only the
+// gathering of the template taps, which moves floats without arithmetic,
+// differs: an 8×8 transpose with AVX, a plain copy otherwise.
+//
+// Per pixel u this is pixelTerm of eklt_cost.cpp: the warped point in crop
+// coordinates x = R u + (t − origin), the Catmull-Rom weights of its
+// fractional part, the template gradient g and ∂g/∂x from the 4×4 taps,
+// a = −g·w and ∂a/∂p. Each group's lanes accumulate their own partial sums
+// (Σ a², Σ a m, Σ|a|, the ten products of D, Σ a ∂a/∂p, Σ m ∂a/∂p), added
+// lane by lane in double precision at the end.
+#include <algorithm>
+#include <cstdint>
+
+#include "eklt_sums.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define EVIO_EKLT_SINGLE_AVX 1
+#endif
+
+#define EVIO_LANES inline __attribute__((always_inline))
+
+// Vector types of 32 bytes without AVX change the calling convention of
+// functions taking them by value; every such function here is inlined.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace evio::estimator::detail {
+
+namespace baseline_lanes {
+#include "eklt_cost_single_lanes.inc"
+}  // namespace baseline_lanes
+
+#if defined(EVIO_EKLT_SINGLE_AVX)
+#pragma GCC push_options
+#pragma GCC target("avx")
+#define EVIO_LANES_AVX 1
+namespace avx_lanes {
+#include "eklt_cost_single_lanes.inc"
+}  // namespace avx_lanes
+#undef EVIO_LANES_AVX
+#pragma GCC pop_options
+#endif
+
+void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, bool avx, EkltSums* sums) {
+#if defined(EVIO_EKLT_SINGLE_AVX)
+  if (avx) {
+    avx_lanes::sumPatchLanes(batch, warp, sums);
+    return;
+  }
+#endif
+  (void)avx;
+  baseline_lanes::sumPatchLanes(batch, warp, sums);
+}
+
+}  // namespace evio::estimator::detail

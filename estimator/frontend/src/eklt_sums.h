@@ -1,0 +1,32 @@
+#pragma once
+// Internal to the EKLT cost (eklt_cost.cpp, eklt_cost_single.cpp): the sums
+// over the patch that evaluateEklt turns into cost, JᵀJ and Jᵀr.
+#include "evio/estimator/frontend/eklt_cost.h"
+
+namespace evio::estimator::detail {
+
+struct EkltSums {
+  double aa = 0.0, am = 0.0, abs_sum = 0.0;  // Σ a², Σ a m, Σ |a|
+  double d[4][4] = {};                       // D = Σ ∂a/∂pᵀ ∂a/∂p (upper triangle used)
+  Vec4 da_a = Vec4::Zero();                  // Σ a ∂a/∂p
+  Vec4 da_m = Vec4::Zero();                  // Σ m ∂a/∂p
+};
+
+/// One parameter vector's warp W(u) = R(θ) u + t and flow w = R(θ) v(φ)
+/// (eklt_cost.h), w⊥ = ∂w/∂φ.
+struct EkltWarp {
+  double c, s;  // cos θ, sin θ
+  Vec2 t;
+  Vec2 w, w_perp;
+};
+
+/// The sums with the Jacobian in single precision, eight pixels per lane
+/// group, lane-wise partial sums added in a fixed order at the end. Needs
+/// P ≥ 8 and every lookup's 4×4 taps inside the template crop. Every lane
+/// operation is one IEEE single-precision operation, without FMA, in the
+/// same order on the AVX and the SSE2 path: the same bits on any x86-64 CPU.
+/// `avx`: take the AVX path (the caller checked the CPU has it).
+void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, bool avx, EkltSums* sums);
+
+
+}  // namespace evio::estimator::detail

@@ -64,8 +64,6 @@ struct EkltTracker::Slot {
   double flow_angle = 0.0;     // φ
   Vec2 centre = Vec2::Zero();  // current position = accumulation centre of the batch
   TimeNs t_centre_ns = 0;
-  Vec2 last_step = Vec2::Zero();  // px, from the track point before to the last one
-  bool has_step = false;
   double offset_x = 0.0;       // h − centre: patch coordinate of an event = pixel + offset
   double offset_y = 0.0;
   std::vector<float> patch;    // P², polarity-weighted bilinear splats
@@ -171,7 +169,6 @@ void EkltTracker::activate(int index, const Vec2& uv, TimeNs t_ns, double flow_a
   s.t_centre_ns = t_ns;
   s.flow_angle = wrapAngle(flow_angle);
   s.quality = 1.0;
-  s.has_step = false;
   resetPatch(s);
   // Initial batch size from the template seen along the initial flow.
   Part& part = partOf(index);
@@ -366,14 +363,11 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
   std::vector<float>& measured = part.measured;
   for (std::size_t k = 0; k < s.patch.size(); ++k) measured[k] = s.patch[k] * inv;
 
-  // Initial guess: the previous warp, with the centre moved to the
-  // prediction (the gyro's when enabled, else the feature's last step
-  // repeated): t = x0 − R(θ)(c_pred − c).
+  // Initial guess: the previous warp, with the centre moved to the gyro
+  // prediction when enabled: t = x0 − R(θ)(c_pred − c).
   Vec2 predicted = s.centre;
   if (predictor_ && !predictor_->empty()) {
     if (auto uv = predictor_->predict(s.centre, s.t_centre_ns, t_mid)) predicted = *uv;
-  } else if (options_.step_prediction && s.has_step) {
-    predicted = s.centre + s.last_step;
   }
   const double c = std::cos(s.theta);
   const double sn = std::sin(s.theta);
@@ -400,8 +394,6 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
   s.theta = sol.p[0];
   s.flow_angle = wrapAngle(sol.p[3]);
   s.quality = sol.quality();
-  s.last_step = uv - s.centre;
-  s.has_step = true;
   s.centre = uv;
   s.t_centre_ns = t_mid;
   s.batch_size = batchSize(sol.abs_sum);

@@ -95,15 +95,6 @@ struct EkltOptions {
 
   // Prediction and images.
   bool imu_prediction = false;         ///< predict each batch's start from the gyro (needs IMU and T_B_C)
-  /// Without the gyro prediction: start each batch's optimisation from the
-  /// feature's last position moved by its last step (the displacement
-  /// between its last two track points), else from the last position. A
-  /// batch holds the events of about batch_displacement_px of motion, so
-  /// consecutive steps are alike whatever the speed; a step in time (image
-  /// velocity × time) was not: a noisy step over a short batch, extrapolated
-  /// over a long one, put 12 % of the CPU samples in the slower lookup at
-  /// the template's border (poster_6dof, perf), against 3 % with steps.
-  bool step_prediction = true;
   double log_offset = 0.01;            ///< L = log(I/255 + offset) for 8-bit frames
 
   template <class V>
@@ -134,7 +125,6 @@ struct EkltOptions {
     v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");
     v("bootstrap_pyramid_levels", bootstrap_pyramid_levels, "bootstrap KLT pyramid levels");
     v("imu_prediction", imu_prediction, "predict feature positions from the gyro");
-    v("step_prediction", step_prediction, "start each batch from the feature's last step");
     v("log_offset", log_offset, "offset in log(I/255 + offset)");
   }
 

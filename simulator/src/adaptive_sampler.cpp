@@ -1,7 +1,10 @@
 #include "evio/simulator/adaptive_sampler.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "evio/core/error.h"
 
@@ -35,6 +38,47 @@ cv::Mat AdaptiveSampler::logImage(const cv::Mat& radiance) const {
   return out;
 }
 
+void AdaptiveSampler::logRow(const cv::Mat& radiance, int y, int x0, int x1, cv::Mat* log_image) const {
+  const float* in = radiance.ptr<float>(y);
+  float* o = log_image->ptr<float>(y);
+  for (int x = x0; x < x1; ++x) o[x] = std::log(log_eps_ + (in[x] > 0.0f ? in[x] : 0.0f));  // as logImage
+}
+
+void AdaptiveSampler::logRatesOfRow(const cv::Mat& log_image, const cv::Mat& flow, int y, int x0, int x1,
+                                    float* rates) const {
+  const int w = log_image.cols, h = log_image.rows;
+  if (!options_.rate_bound || y == 0 || y + 1 == h) {
+    for (int x = x0; x < x1; ++x) rates[x - x0] = logRateAt(log_image, flow, x, y);
+    return;
+  }
+  // Pixels with all 8 neighbours: logRateAt's float operations in the same
+  // order, without its bounds tests (the maximum does not depend on the order
+  // of its terms; NaN never wins).
+  const int xa = std::max(x0, 1), xb = std::max(xa, std::min(x1, w - 1));
+  for (int x = x0; x < xa; ++x) rates[x - x0] = logRateAt(log_image, flow, x, y);
+  const float* up = log_image.ptr<float>(y - 1);
+  const float* mid = log_image.ptr<float>(y);
+  const float* down = log_image.ptr<float>(y + 1);
+  const cv::Vec2f* f = flow.ptr<cv::Vec2f>(y);
+  constexpr float kDiag = 0.70710678f;
+  for (int x = xa; x < xb; ++x) {
+    const float l = mid[x];
+    float slope = 0.0f;
+    const auto take = [&slope](float d) { slope = d > slope ? d : slope; };
+    take(std::abs(up[x - 1] - l) * kDiag);
+    take(std::abs(up[x] - l) * 1.0f);
+    take(std::abs(up[x + 1] - l) * kDiag);
+    take(std::abs(mid[x - 1] - l) * 1.0f);
+    take(std::abs(mid[x + 1] - l) * 1.0f);
+    take(std::abs(down[x - 1] - l) * kDiag);
+    take(std::abs(down[x] - l) * 1.0f);
+    take(std::abs(down[x + 1] - l) * kDiag);
+    const float rate = slope * 1.0823922f * std::sqrt(f[x][0] * f[x][0] + f[x][1] * f[x][1]);
+    rates[x - x0] = std::isfinite(rate) ? rate : 0.0f;
+  }
+  for (int x = xb; x < x1; ++x) rates[x - x0] = logRateAt(log_image, flow, x, y);
+}
+
 float AdaptiveSampler::logRateAt(const cv::Mat& log_image, const cv::Mat& flow, int x, int y) const {
   const int w = log_image.cols, h = log_image.rows;
   const cv::Vec2f f = flow.at<cv::Vec2f>(y, x);
@@ -61,6 +105,33 @@ float AdaptiveSampler::logRateAt(const cv::Mat& log_image, const cv::Mat& flow, 
     rate = std::abs(gx * f[0] + gy * f[1]);
   }
   return std::isfinite(rate) ? rate : 0.0f;
+}
+
+namespace {
+/// A key of a float's bits that sorts as the floats do (−0 before +0).
+std::uint32_t orderedKey(float v) {
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &v, sizeof(bits));
+  return (bits & 0x80000000u) != 0 ? ~bits : bits | 0x80000000u;
+}
+}  // namespace
+
+float AdaptiveSampler::kthSmallest(std::vector<float>* values, std::size_t k) {
+  std::vector<float>& v = *values;
+  require(k < v.size(), "AdaptiveSampler::kthSmallest: k out of range");
+  // Bins of the top 12 bits of the key: count, find the k-th's bin, then
+  // select within the values of that bin only.
+  constexpr int kShift = 20;
+  std::array<std::uint32_t, (1u << (32 - kShift))> count{};
+  for (const float x : v) ++count[orderedKey(x) >> kShift];
+  std::size_t below = 0, bin = 0;
+  while (below + count[bin] <= k) below += count[bin++];
+  std::size_t n = 0;  // the bin's values, moved to the front
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if ((orderedKey(v[i]) >> kShift) == bin) std::swap(v[n++], v[i]);
+  const auto kth = v.begin() + static_cast<std::ptrdiff_t>(k - below);
+  std::nth_element(v.begin(), kth, v.begin() + static_cast<std::ptrdiff_t>(n));
+  return *kth;
 }
 
 TimeNs AdaptiveSampler::interval(float log_rate) const {

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <numbers>
 #include <iostream>
+#include <random>
+#include <vector>
 
 #include "evio/core/error.h"
 #include "evio/simulator/event_camera.h"
@@ -317,6 +319,32 @@ TEST(AdaptiveSampling, PerPixelSamplingKeepsTheAccuracyOfAFineWholeFrameStep) {
     EXPECT_LT(a.updates, esim_updates) << tile_px;
   }
   EXPECT_GT(ev_ref.size(), 20000u);
+}
+
+TEST(AdaptiveSampler, KthSmallestIsTheValueNthElementSelects) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> spread(0.0f, 50.0f);
+  std::uniform_int_distribution<int> level(0, 5);
+  for (const std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{17}, std::size_t{1000}, std::size_t{90000}}) {
+    // Rates as the predictor's: many exact zeros, repeated values, a long tail;
+    // a few negative values and −0 to check the ordering of the keys.
+    std::vector<float> values(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int l = level(rng);
+      values[i] = l == 0 ? 0.0f : l == 1 ? 3.5f : l == 2 ? -0.0f : spread(rng) * spread(rng);
+      if (i % 101 == 50) values[i] = -spread(rng);
+    }
+    const std::size_t step = n < 2000 ? 1 : 997;
+    for (std::size_t k = 0; k < n; k += step) {
+      std::vector<float> expected = values, scratch = values;
+      std::nth_element(expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(k), expected.end());
+      ASSERT_EQ(AdaptiveSampler::kthSmallest(&scratch, k), expected[k]) << "n " << n << " k " << k;
+    }
+    std::vector<float> scratch = values;
+    EXPECT_EQ(AdaptiveSampler::kthSmallest(&scratch, n - 1), *std::max_element(values.begin(), values.end()));
+  }
+  std::vector<float> none;
+  EXPECT_THROW(AdaptiveSampler::kthSmallest(&none, 0), Error);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <limits>
 
@@ -211,6 +212,8 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
   s.dx.resize(padded);
   s.dy.resize(padded);
   s.dz.resize(padded);
+  s.bx.resize(padded);
+  s.by.resize(padded);
   s.bz.resize(padded);
   RTCRayHit active{};  // every field but the direction
   scenes::setRayHit(active, org, Eigen::Vector3f::UnitZ());
@@ -232,7 +235,9 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
     const __m256 by = _mm256_loadu_ps(bearing + tile_stride_ + ri);
     const __m256 bz = _mm256_loadu_ps(bearing + 2 * tile_stride_ + ri);
     const __m256 none = _mm256_cmp_ps(bx, bx, _CMP_UNORD_Q);
-    _mm256_storeu_ps(s.bz.data() + ri, bz);  // for writeOutputs
+    _mm256_storeu_ps(s.bx.data() + ri, bx);  // for writeOutputs
+    _mm256_storeu_ps(s.by.data() + ri, by);
+    _mm256_storeu_ps(s.bz.data() + ri, bz);
     // d = R b, row i as Eigen evaluates it: R_i0 b_x + (R_i1 b_y + R_i2 b_z);
     // +z where there is no ray (as the scalar path).
     float* d[3] = {s.dx.data() + ri, s.dy.data() + ri, s.dz.data() + ri};
@@ -365,25 +370,28 @@ void Renderer::flowRowAvx2(int y, int x0, int x1, std::size_t r0, const CameraVe
     const __m256d nvx = _mm256_set1_pd(-velocity.v_C.x()), nvy = _mm256_set1_pd(-velocity.v_C.y()),
                   nvz = _mm256_set1_pd(-velocity.v_C.z());
     const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
-    alignas(32) double bx[4], by[4], bz[4], range[4], hit[4];
-    alignas(32) float u_dot[4], v_dot[4];
+    const __m256d nan = _mm256_set1_pd(std::numeric_limits<double>::quiet_NaN());
+    const __m256i lane_bit = _mm256_setr_epi64x(1, 2, 4, 8);
+    const __m128i tfar_index = _mm_setr_epi32(0, 20, 40, 60);  // RTCRayHit is 20 floats
+    static_assert(sizeof(RTCRayHit) == 20 * sizeof(float), "RTCRayHit layout");
     for (; x + 4 <= x1; x += 4) {
       const std::size_t p = row + static_cast<std::size_t>(x);
-      if ((flow_in_front_[p] & flow_in_front_[p + 1] & flow_in_front_[p + 2] & flow_in_front_[p + 3]) == 0) {
+      std::uint32_t in_front = 0;  // four flags, one byte each
+      std::memcpy(&in_front, flow_in_front_.data() + p, sizeof(in_front));
+      if (in_front != 0x01010101u) {
         for (int k = 0; k < 4; ++k) onePixel(x + k);
         continue;
       }
-      for (std::size_t k = 0; k < 4; ++k) {
-        const Eigen::Vector3f& b = bearings_[p + k];
-        const std::size_t r = r0 + static_cast<std::size_t>(x - x0) + k;
-        bx[k] = b.x();
-        by[k] = b.y();
-        bz[k] = b.z();
-        range[k] = s.rays[r].ray.tfar;
-        hit[k] = hitAt(r) ? -1.0 : 0.0;  // sign bit set: hit (for blendv)
-      }
-      const __m256d is_hit = _mm256_load_pd(hit), t = _mm256_load_pd(range);
-      const __m256d b_x = _mm256_load_pd(bx), b_y = _mm256_load_pd(by), b_z = _mm256_load_pd(bz);
+      // Rays r .. r + 3: bearings (float, exactly widened), ray lengths, hits.
+      const std::size_t r = r0 + static_cast<std::size_t>(x - x0);
+      const __m256d b_x = _mm256_cvtps_pd(_mm_loadu_ps(s.bx.data() + r));
+      const __m256d b_y = _mm256_cvtps_pd(_mm_loadu_ps(s.by.data() + r));
+      const __m256d b_z = _mm256_cvtps_pd(_mm_loadu_ps(s.bz.data() + r));
+      const __m256d t = _mm256_cvtps_pd(_mm_i32gather_ps(&s.rays[r].ray.tfar, tfar_index, 4));
+      const std::size_t g = r / kLanes, shift = r % kLanes;
+      const unsigned word = shift <= 4 ? s.hit_mask[g] : s.hit_mask[g] | (unsigned{s.hit_mask[g + 1]} << 8);
+      const __m256i bits = _mm256_set1_epi64x(static_cast<long long>((word >> shift) & 0xfu));
+      const __m256d is_hit = _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bits, lane_bit), lane_bit));
       // p: the point b · range where the ray hit, the bearing b elsewhere.
       const __m256d px = _mm256_blendv_pd(b_x, _mm256_mul_pd(b_x, t), is_hit);
       const __m256d py = _mm256_blendv_pd(b_y, _mm256_mul_pd(b_y, t), is_hit);
@@ -404,14 +412,15 @@ void Renderer::flowRowAvx2(int y, int x0, int x1, std::size_t r0, const CameraVe
                     v2 = _mm256_mul_pd(fy, _mm256_mul_pd(_mm256_xor_pd(b, sign), z_inv));
       const __m256d u = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(u0, dx), _mm256_mul_pd(u1, dy)), _mm256_mul_pd(u2, dz));
       const __m256d v = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(v0, dx), _mm256_mul_pd(v1, dy)), _mm256_mul_pd(v2, dz));
-      // Finite: |value| < inf (false for NaN); NaN flow elsewhere.
+      // Both finite: |value| < inf (false for NaN); else the flow is NaN
+      // (the double quiet NaN narrows to kNaN's bits). Stored as (u̇, v̇) pairs.
       const __m256d finite = _mm256_and_pd(_mm256_cmp_pd(_mm256_andnot_pd(sign, u), inf, _CMP_LT_OQ),
                                            _mm256_cmp_pd(_mm256_andnot_pd(sign, v), inf, _CMP_LT_OQ));
-      const int ok = _mm256_movemask_pd(finite);
-      _mm_store_ps(u_dot, _mm256_cvtpd_ps(u));
-      _mm_store_ps(v_dot, _mm256_cvtpd_ps(v));
-      for (std::size_t k = 0; k < 4; ++k)
-        flow[x + static_cast<int>(k)] = ((ok >> k) & 1) != 0 ? cv::Vec2f(u_dot[k], v_dot[k]) : cv::Vec2f(kNaN, kNaN);
+      const __m128 u_f = _mm256_cvtpd_ps(_mm256_blendv_pd(nan, u, finite));
+      const __m128 v_f = _mm256_cvtpd_ps(_mm256_blendv_pd(nan, v, finite));
+      auto* out = reinterpret_cast<float*>(flow + x);
+      _mm_storeu_ps(out, _mm_unpacklo_ps(u_f, v_f));
+      _mm_storeu_ps(out + 4, _mm_unpackhi_ps(u_f, v_f));
     }
   }
   for (; x < x1; ++x) onePixel(x);

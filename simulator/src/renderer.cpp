@@ -13,6 +13,7 @@
 #include "evio/core/cpu_features.h"
 #include "evio/core/error.h"
 #include "evio/scenes/embree_util.h"
+#include "parallel_for.h"
 #include "renderer_scratch.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -140,8 +141,7 @@ void Renderer::renderTileList(const Pose& T_W_C, const CameraVelocity* velocity,
                               RenderOutput* out, RenderStats* stats) const {
   std::vector<RenderStats> counts(count);
   const auto tileAt = [tiles](std::size_t i) { return tiles ? tiles[i] : static_cast<int>(i); };
-  tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
-  arena.execute([&] {
+  sharedArena(options_.threads).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       Scratch& s = scratch_->local.local();
       for (std::size_t i = r.begin(); i != r.end(); ++i) renderTile(tileAt(i), T_W_C, velocity, out, &counts[i], &s);

@@ -107,6 +107,7 @@ class AdaptiveSampler {
   double threshold_ = 0.0;
   float log_eps_ = 0.0f;
   TimeNs min_interval_ns_ = 0, max_interval_ns_ = 0;
+  bool avx2_ = false;  ///< logRatesOfRow's interior eight pixels at a time (same bits)
 };
 
 }  // namespace evio::simulator

@@ -12,6 +12,7 @@
 #include "evio/core/error.h"
 #include "evio/simulator/counter_rng.h"
 #include "evio/simulator/davis_auto_exposure.h"
+#include "parallel_for.h"
 
 namespace evio::simulator {
 
@@ -187,8 +188,7 @@ Frame FrameCamera::capture(TimeNs t_start_ns, const std::vector<cv::Mat>& sub_sa
   if (options_.threads == 1) {
     rows(0, height_);
   } else {
-    tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
-    arena.execute([&] {
+    sharedArena(options_.threads).execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, height_, 8),
                         [&](const tbb::blocked_range<int>& r) { rows(r.begin(), r.end()); });
     });

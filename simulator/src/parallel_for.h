@@ -10,8 +10,25 @@
 #include <tbb/task_arena.h>
 
 #include <cstddef>
+#include <map>
+#include <memory>
+#include <mutex>
 
 namespace evio::simulator {
+
+/// The TBB arena of `threads` workers (0: all cores), made on first use and
+/// kept for the process (never destroyed). One arena for all the simulator's
+/// parallel loops: an arena made per loop (thousands per simulated second)
+/// is joined by the worker threads only after a wake-up, often after the
+/// calling thread has done most of a short loop alone.
+inline tbb::task_arena& sharedArena(int threads) {
+  static std::mutex mutex;
+  static auto* arenas = new std::map<int, std::unique_ptr<tbb::task_arena>>();
+  const std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<tbb::task_arena>& arena = (*arenas)[threads];
+  if (!arena) arena = threads > 0 ? std::make_unique<tbb::task_arena>(threads) : std::make_unique<tbb::task_arena>();
+  return *arena;
+}
 
 template <class F>
 void parallelFor(int threads, std::size_t count, std::size_t grain, const F& f) {
@@ -19,8 +36,7 @@ void parallelFor(int threads, std::size_t count, std::size_t grain, const F& f) 
     for (std::size_t i = 0; i < count; ++i) f(i);
     return;
   }
-  tbb::task_arena arena = threads > 0 ? tbb::task_arena(threads) : tbb::task_arena();
-  arena.execute([&] {
+  sharedArena(threads).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, grain), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
     });

@@ -12,6 +12,7 @@
 #include "evio/simulator/frame_camera.h"
 #include "evio/simulator/renderer.h"
 #include "evio/simulator/tile_schedule.h"
+#include "parallel_for.h"
 
 namespace evio::simulator {
 
@@ -41,27 +42,33 @@ AdaptiveSampler::Options samplerOptions(const RenderScheduleOptions& o) {
 }
 
 /// The next render interval: λ C over the q-quantile of the predicted
-/// per-pixel |dL/dt|, within the sampler's rate bounds.
+/// per-pixel |dL/dt|, within the sampler's rate bounds. Rows in parallel
+/// (each writes its own entries, so the result does not depend on the
+/// thread count).
 class StepPredictor {
  public:
-  StepPredictor(const RenderScheduleOptions& o, const EventCamera::Options& ec)
+  StepPredictor(const RenderScheduleOptions& o, const EventCamera::Options& ec, int threads)
       : sampler_(samplerOptions(o), std::min(ec.threshold_pos, ec.threshold_neg), ec.logEpsilon()),
-        quantile_(o.fastest_pixel_quantile) {}
+        quantile_(o.fastest_pixel_quantile),
+        threads_(threads) {}
 
   TimeNs interval(const cv::Mat& radiance, const cv::Mat& flow) {
-    const cv::Mat l = sampler_.logImage(radiance);
-    rates_.clear();
-    rates_.reserve(static_cast<std::size_t>(l.rows) * static_cast<std::size_t>(l.cols));
-    for (int y = 0; y < l.rows; ++y)
-      for (int x = 0; x < l.cols; ++x) rates_.push_back(sampler_.logRateAt(l, flow, x, y));
-    if (rates_.empty()) return sampler_.interval(0.0f);
+    const int w = radiance.cols, h = radiance.rows;
+    if (w == 0 || h == 0) return sampler_.interval(0.0f);
+    log_.create(h, w, CV_32FC1);
+    rates_.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    constexpr std::size_t kRowsPerTask = 8;
+    parallelFor(threads_, static_cast<std::size_t>(h), kRowsPerTask,
+                [&](std::size_t y) { sampler_.logRow(radiance, static_cast<int>(y), 0, w, &log_); });
+    parallelFor(threads_, static_cast<std::size_t>(h), kRowsPerTask, [&](std::size_t y) {
+      sampler_.logRatesOfRow(log_, flow, static_cast<int>(y), 0, w, rates_.data() + y * static_cast<std::size_t>(w));
+    });
     float rate = 0.0f;
     if (quantile_ >= 1.0) {
       rate = *std::max_element(rates_.begin(), rates_.end());
     } else {
       const auto k = static_cast<std::ptrdiff_t>(quantile_ * static_cast<double>(rates_.size() - 1));
-      std::nth_element(rates_.begin(), rates_.begin() + k, rates_.end());
-      rate = rates_[static_cast<std::size_t>(k)];
+      rate = AdaptiveSampler::kthSmallest(&rates_, static_cast<std::size_t>(k));
     }
     return sampler_.interval(rate);
   }
@@ -69,7 +76,9 @@ class StepPredictor {
  private:
   AdaptiveSampler sampler_;
   double quantile_;
-  std::vector<float> rates_;
+  int threads_;
+  cv::Mat log_;               ///< L = log(ε + I) of the latest render
+  std::vector<float> rates_;  ///< predicted |dL/dt| per pixel (1/s), row-major
 };
 
 /// t = target^γ · full_well / (K · mean radiance) within the exposure limits:
@@ -126,7 +135,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   EventCamera::Options eo = o.rig.event_camera.sensor.event_camera;
   eo.threads = o.threads;
   EventCamera events_cam(event_cam.width(), event_cam.height(), eo, o.seed);
-  StepPredictor predictor(o.sampling, eo);
+  StepPredictor predictor(o.sampling, eo, o.threads);
   const bool tile_mode = o.sampling.tiles();
   std::optional<TileSchedule> tile_schedule;
   if (tile_mode)

@@ -13,6 +13,7 @@
 #include "evio/core/cpu_features.h"
 #include "evio/core/error.h"
 #include "evio/scenes/embree_util.h"
+#include "parallel_for.h"
 #include "renderer_scratch.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -49,6 +50,15 @@ Renderer::Renderer(const scenes::Scene& scene, const Camera& camera, const Rende
               unprojectOrNan(camera_, Vec2(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5));
     }
   pixel_angle_rad_ = static_cast<float>(1.0 / camera_.intrinsics()[0]);
+  if (const PinholeCamera* pinhole = camera_.as<PinholeCamera>()) {
+    pinhole_flow_.emplace(*pinhole);
+    flow_in_front_.resize(bearings_.size());
+    for (std::size_t p = 0; p < bearings_.size(); ++p) {
+      const Vec3 b = bearings_[p].cast<double>();
+      flow_in_front_[p] = static_cast<std::uint8_t>(b.allFinite() && isInFrontOfCamera(b) &&
+                                                    b.z() > 2.0 * kMinCosAngle * b.norm());
+    }
+  }
   // Tile buffers per thread, reused from render to render (no allocation
   // and first-touch page faults per frame). Copies of the renderer share
   // the pool, which is safe: a thread uses its buffers for one tile at a time.
@@ -131,8 +141,7 @@ void Renderer::renderTileList(const Pose& T_W_C, const CameraVelocity* velocity,
                               RenderOutput* out, RenderStats* stats) const {
   std::vector<RenderStats> counts(count);
   const auto tileAt = [tiles](std::size_t i) { return tiles ? tiles[i] : static_cast<int>(i); };
-  tbb::task_arena arena = options_.threads > 0 ? tbb::task_arena(options_.threads) : tbb::task_arena();
-  arena.execute([&] {
+  sharedArena(options_.threads).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       Scratch& s = scratch_->local.local();
       for (std::size_t i = r.begin(); i != r.end(); ++i) renderTile(tileAt(i), T_W_C, velocity, out, &counts[i], &s);
@@ -338,9 +347,7 @@ template <bool kAvx2>
       }
       if (flow) {
         Vec2 f;
-        const Vec3 bd = b.cast<double>();
-        const bool ok = hit ? pointFlow(camera_, bd * static_cast<double>(range), *velocity, &f)
-                            : directionFlow(camera_, bd, *velocity, &f);
+        const bool ok = pixelFlow(b, hit, range, *velocity, &f);
         flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
       }
     }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <limits>
 
@@ -211,6 +212,8 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
   s.dx.resize(padded);
   s.dy.resize(padded);
   s.dz.resize(padded);
+  s.bx.resize(padded);
+  s.by.resize(padded);
   s.bz.resize(padded);
   RTCRayHit active{};  // every field but the direction
   scenes::setRayHit(active, org, Eigen::Vector3f::UnitZ());
@@ -232,7 +235,9 @@ std::uint64_t Renderer::setupRaysAvx2(int tile, std::size_t rays, const Eigen::M
     const __m256 by = _mm256_loadu_ps(bearing + tile_stride_ + ri);
     const __m256 bz = _mm256_loadu_ps(bearing + 2 * tile_stride_ + ri);
     const __m256 none = _mm256_cmp_ps(bx, bx, _CMP_UNORD_Q);
-    _mm256_storeu_ps(s.bz.data() + ri, bz);  // for writeOutputs
+    _mm256_storeu_ps(s.bx.data() + ri, bx);  // for writeOutputs
+    _mm256_storeu_ps(s.by.data() + ri, by);
+    _mm256_storeu_ps(s.bz.data() + ri, bz);
     // d = R b, row i as Eigen evaluates it: R_i0 b_x + (R_i1 b_y + R_i2 b_z);
     // +z where there is no ray (as the scalar path).
     float* d[3] = {s.dx.data() + ri, s.dy.data() + ri, s.dz.data() + ri};
@@ -337,24 +342,88 @@ void Renderer::writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity
       depth[x] = hit ? s.rays[ri].ray.tfar * b.z() : kInf;
       normal[x] = hit ? cv::Vec3f(s.columns.nx[ri], s.columns.ny[ri], s.columns.nz[ri]) : cv::Vec3f(0.0f, 0.0f, 0.0f);
     }
-    if (!flow) continue;
-    const std::size_t row_start = ri - static_cast<std::size_t>(x1 - x0);
-    for (x = x0; x < x1; ++x) {
-      const std::size_t r = row_start + static_cast<std::size_t>(x - x0);
-      const Eigen::Vector3f& b = bearings_[row + static_cast<std::size_t>(x)];
-      if (std::isnan(b.x())) {
-        flow[x] = cv::Vec2f(kNaN, kNaN);
-        continue;
-      }
-      const bool hit = (s.hit_mask[r / kLanes] >> (r % kLanes)) & 1;
-      Vec2 f;
-      const Vec3 bd = b.cast<double>();
-      const bool ok = hit ? pointFlow(camera_, bd * static_cast<double>(s.rays[r].ray.tfar), *velocity, &f)
-                          : directionFlow(camera_, bd, *velocity, &f);
-      flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
-    }
+    if (flow) flowRowAvx2(y, x0, x1, ri - static_cast<std::size_t>(x1 - x0), *velocity, flow, s);
   }
   _mm_sfence();  // the streaming stores are visible before the tile is reported done
+}
+
+EVIO_AVX2_FN
+void Renderer::flowRowAvx2(int y, int x0, int x1, std::size_t r0, const CameraVelocity& velocity, cv::Vec2f* flow,
+                           const Scratch& s) const {
+  const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(camera_.width());
+  const auto hitAt = [&s](std::size_t r) { return ((s.hit_mask[r / kLanes] >> (r % kLanes)) & 1) != 0; };
+  const auto onePixel = [&](int x) {
+    const std::size_t r = r0 + static_cast<std::size_t>(x - x0);
+    const Eigen::Vector3f& b = bearings_[row + static_cast<std::size_t>(x)];
+    Vec2 f;
+    const bool ok = !std::isnan(b.x()) && pixelFlow(b, hitAt(r), s.rays[r].ray.tfar, velocity, &f);
+    flow[x] = ok ? cv::Vec2f(static_cast<float>(f.x()), static_cast<float>(f.y())) : cv::Vec2f(kNaN, kNaN);
+  };
+  int x = x0;
+  if (pinhole_flow_) {
+    // PinholeFlow::point and ::direction lane by lane (double), the same
+    // operations in the same order; the front test is flow_in_front_.
+    const __m256d fx = _mm256_set1_pd(pinhole_flow_->fx()), fy = _mm256_set1_pd(pinhole_flow_->fy());
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), sign = _mm256_set1_pd(-0.0);
+    const __m256d wx = _mm256_set1_pd(velocity.omega_C.x()), wy = _mm256_set1_pd(velocity.omega_C.y()),
+                  wz = _mm256_set1_pd(velocity.omega_C.z());
+    const __m256d nvx = _mm256_set1_pd(-velocity.v_C.x()), nvy = _mm256_set1_pd(-velocity.v_C.y()),
+                  nvz = _mm256_set1_pd(-velocity.v_C.z());
+    const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+    const __m256d nan = _mm256_set1_pd(std::numeric_limits<double>::quiet_NaN());
+    const __m256i lane_bit = _mm256_setr_epi64x(1, 2, 4, 8);
+    const __m128i tfar_index = _mm_setr_epi32(0, 20, 40, 60);  // RTCRayHit is 20 floats
+    static_assert(sizeof(RTCRayHit) == 20 * sizeof(float), "RTCRayHit layout");
+    for (; x + 4 <= x1; x += 4) {
+      const std::size_t p = row + static_cast<std::size_t>(x);
+      std::uint32_t in_front = 0;  // four flags, one byte each
+      std::memcpy(&in_front, flow_in_front_.data() + p, sizeof(in_front));
+      if (in_front != 0x01010101u) {
+        for (int k = 0; k < 4; ++k) onePixel(x + k);
+        continue;
+      }
+      // Rays r .. r + 3: bearings (float, exactly widened), ray lengths, hits.
+      const std::size_t r = r0 + static_cast<std::size_t>(x - x0);
+      const __m256d b_x = _mm256_cvtps_pd(_mm_loadu_ps(s.bx.data() + r));
+      const __m256d b_y = _mm256_cvtps_pd(_mm_loadu_ps(s.by.data() + r));
+      const __m256d b_z = _mm256_cvtps_pd(_mm_loadu_ps(s.bz.data() + r));
+      const __m256d t = _mm256_cvtps_pd(_mm_i32gather_ps(&s.rays[r].ray.tfar, tfar_index, 4));
+      const std::size_t g = r / kLanes, shift = r % kLanes;
+      const unsigned word = shift <= 4 ? s.hit_mask[g] : s.hit_mask[g] | (unsigned{s.hit_mask[g + 1]} << 8);
+      const __m256i bits = _mm256_set1_epi64x(static_cast<long long>((word >> shift) & 0xfu));
+      const __m256d is_hit = _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bits, lane_bit), lane_bit));
+      // p: the point b · range where the ray hit, the bearing b elsewhere.
+      const __m256d px = _mm256_blendv_pd(b_x, _mm256_mul_pd(b_x, t), is_hit);
+      const __m256d py = _mm256_blendv_pd(b_y, _mm256_mul_pd(b_y, t), is_hit);
+      const __m256d pz = _mm256_blendv_pd(b_z, _mm256_mul_pd(b_z, t), is_hit);
+      // ω × p, then ṗ = −v − ω × p (hit) or −(ω × p) (direction).
+      const __m256d cx = _mm256_sub_pd(_mm256_mul_pd(wy, pz), _mm256_mul_pd(wz, py));
+      const __m256d cy = _mm256_sub_pd(_mm256_mul_pd(wz, px), _mm256_mul_pd(wx, pz));
+      const __m256d cz = _mm256_sub_pd(_mm256_mul_pd(wx, py), _mm256_mul_pd(wy, px));
+      const __m256d dx = _mm256_blendv_pd(_mm256_xor_pd(cx, sign), _mm256_sub_pd(nvx, cx), is_hit);
+      const __m256d dy = _mm256_blendv_pd(_mm256_xor_pd(cy, sign), _mm256_sub_pd(nvy, cy), is_hit);
+      const __m256d dz = _mm256_blendv_pd(_mm256_xor_pd(cz, sign), _mm256_sub_pd(nvz, cz), is_hit);
+      // J = [fx z⁻¹, fx·0, fx (−a z⁻¹); fy·0, fy z⁻¹, fy (−b z⁻¹)], a = x z⁻¹, b = y z⁻¹.
+      const __m256d z_inv = _mm256_div_pd(one, pz);
+      const __m256d a = _mm256_mul_pd(px, z_inv), b = _mm256_mul_pd(py, z_inv);
+      const __m256d u0 = _mm256_mul_pd(fx, z_inv), u1 = _mm256_mul_pd(fx, zero),
+                    u2 = _mm256_mul_pd(fx, _mm256_mul_pd(_mm256_xor_pd(a, sign), z_inv));
+      const __m256d v0 = _mm256_mul_pd(fy, zero), v1 = _mm256_mul_pd(fy, z_inv),
+                    v2 = _mm256_mul_pd(fy, _mm256_mul_pd(_mm256_xor_pd(b, sign), z_inv));
+      const __m256d u = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(u0, dx), _mm256_mul_pd(u1, dy)), _mm256_mul_pd(u2, dz));
+      const __m256d v = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(v0, dx), _mm256_mul_pd(v1, dy)), _mm256_mul_pd(v2, dz));
+      // Both finite: |value| < inf (false for NaN); else the flow is NaN
+      // (the double quiet NaN narrows to kNaN's bits). Stored as (u̇, v̇) pairs.
+      const __m256d finite = _mm256_and_pd(_mm256_cmp_pd(_mm256_andnot_pd(sign, u), inf, _CMP_LT_OQ),
+                                           _mm256_cmp_pd(_mm256_andnot_pd(sign, v), inf, _CMP_LT_OQ));
+      const __m128 u_f = _mm256_cvtpd_ps(_mm256_blendv_pd(nan, u, finite));
+      const __m128 v_f = _mm256_cvtpd_ps(_mm256_blendv_pd(nan, v, finite));
+      auto* out = reinterpret_cast<float*>(flow + x);
+      _mm_storeu_ps(out, _mm_unpacklo_ps(u_f, v_f));
+      _mm_storeu_ps(out + 4, _mm_unpackhi_ps(u_f, v_f));
+    }
+  }
+  for (; x < x1; ++x) onePixel(x);
 }
 
 #else  // no AVX2 code path in this build: avx2_ is never set, these are never called
@@ -366,6 +435,9 @@ std::uint64_t Renderer::setupRaysAvx2(int, std::size_t, const Eigen::Matrix3f&, 
   throw Error("Renderer: this build has no AVX2 path");
 }
 void Renderer::writeOutputs(int, int, int, int, const CameraVelocity*, RenderOutput*, const Scratch&) const {
+  throw Error("Renderer: this build has no AVX2 path");
+}
+void Renderer::flowRowAvx2(int, int, int, std::size_t, const CameraVelocity&, cv::Vec2f*, const Scratch&) const {
   throw Error("Renderer: this build has no AVX2 path");
 }
 #endif

@@ -40,7 +40,7 @@ struct Renderer::Scratch {
   // The 8-lane path (renderer_avx2.cpp): directions, hits and light samples
   // as columns, and the radiance of each ray.
   std::vector<float> dx, dy, dz;
-  std::vector<float> bz;  ///< z of the pixel's bearing in C (NaN: no ray), for the depth
+  std::vector<float> bx, by, bz;  ///< the pixel's bearing in C (NaN: no ray), for the depth and the flow
   scenes::SurfaceHitColumns columns;
   std::vector<scenes::LightColumns> light_columns;
   std::vector<ShadowColumns> shadow_origin;  ///< per light

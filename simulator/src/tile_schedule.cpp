@@ -1,6 +1,7 @@
 #include "evio/simulator/tile_schedule.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -24,7 +25,6 @@ TileSchedule::TileSchedule(int width, int height, int tile_px, const AdaptiveSam
       height_(height),
       tile_px_(tile_px),
       sampler_(perPixel(sampler), threshold, log_eps),
-      log_eps_(static_cast<float>(log_eps)),
       origin_ns_(origin_ns),
       quantum_ns_(quantum_ns),
       threads_(threads) {
@@ -49,74 +49,22 @@ TimeNs TileSchedule::onGrid(TimeNs t_ns, TimeNs interval_ns) const {
 
 void TileSchedule::updateLog(int tile, const cv::Mat& radiance) {
   const cv::Rect r = tileRect(tile);
-  const int x0 = r.x, y0 = r.y, x1 = r.x + r.width, y1 = r.y + r.height;
-  for (int y = y0; y < y1; ++y) {
-    const float* in = radiance.ptr<float>(y);
-    float* l = log_.ptr<float>(y);
-    for (int x = x0; x < x1; ++x) l[x] = std::log(log_eps_ + (in[x] > 0.0f ? in[x] : 0.0f));  // as logImage
-  }
+  for (int y = r.y; y < r.y + r.height; ++y) sampler_.logRow(radiance, y, r.x, r.x + r.width, &log_);
 }
 
 float TileSchedule::tileRate(int tile, const cv::Mat& flow) const {
+  // The largest AdaptiveSampler::logRateAt of the tile's pixels (each >= 0,
+  // non-finite counted as 0), a row at a time.
   const cv::Rect r = tileRect(tile);
+  constexpr int kChunk = 64;
+  std::array<float, kChunk> rates{};
   float rate = 0.0f;
-  if (!sampler_.options().rate_bound) {
-    for (int y = r.y; y < r.y + r.height; ++y)
-      for (int x = r.x; x < r.x + r.width; ++x) rate = std::max(rate, sampler_.logRateAt(log_, flow, x, y));
-    return rate;
-  }
-  // AdaptiveSampler::logRateAt with rate_bound, the same float operations in
-  // the same order, on row pointers: max over the 8 neighbours q of
-  // |L(q) − L(p)| / ‖q − p‖, times 1 / cos 22.5° · ‖u̇v‖; non-finite counts as 0.
-  // Pixels away from the image border: all 8 neighbours exist, no branches
-  // (the maximum does not depend on the order of its terms).
-  const int xa = std::max(r.x, 1), xb = std::min(r.x + r.width, width_ - 1);
-  const auto interior = [&](int y) {
-    const float* up = log_.ptr<float>(y - 1);
-    const float* mid = log_.ptr<float>(y);
-    const float* down = log_.ptr<float>(y + 1);
-    const cv::Vec2f* f = flow.ptr<cv::Vec2f>(y);
-    constexpr float kDiag = 0.70710678f;
-    for (int x = xa; x < xb; ++x) {
-      const float l = mid[x];
-      float slope = 0.0f;
-      const auto take = [&slope](float d) { slope = d > slope ? d : slope; };  // NaN never wins
-      take(std::abs(up[x - 1] - l) * kDiag);
-      take(std::abs(up[x] - l) * 1.0f);
-      take(std::abs(up[x + 1] - l) * kDiag);
-      take(std::abs(mid[x - 1] - l) * 1.0f);
-      take(std::abs(mid[x + 1] - l) * 1.0f);
-      take(std::abs(down[x - 1] - l) * kDiag);
-      take(std::abs(down[x] - l) * 1.0f);
-      take(std::abs(down[x + 1] - l) * kDiag);
-      const float v = slope * 1.0823922f * std::sqrt(f[x][0] * f[x][0] + f[x][1] * f[x][1]);
-      if (std::isfinite(v)) rate = std::max(rate, v);
+  for (int y = r.y; y < r.y + r.height; ++y)
+    for (int x = r.x; x < r.x + r.width; x += kChunk) {
+      const int n = std::min(kChunk, r.x + r.width - x);
+      sampler_.logRatesOfRow(log_, flow, y, x, x + n, rates.data());
+      for (int i = 0; i < n; ++i) rate = std::max(rate, rates[static_cast<std::size_t>(i)]);
     }
-  };
-  // Pixels on the image border: the neighbours that exist.
-  const auto border = [&](int x, int y) {
-    const float l = log_.at<float>(y, x);
-    float slope = 0.0f;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int qx = x + dx, qy = y + dy;
-        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= width_ || qy >= height_) continue;
-        const float d = std::abs(log_.at<float>(qy, qx) - l) * (dx != 0 && dy != 0 ? 0.70710678f : 1.0f);
-        if (d > slope) slope = d;  // NaN never wins
-      }
-    const cv::Vec2f f = flow.at<cv::Vec2f>(y, x);
-    const float v = slope * 1.0823922f * std::sqrt(f[0] * f[0] + f[1] * f[1]);
-    if (std::isfinite(v)) rate = std::max(rate, v);
-  };
-  for (int y = r.y; y < r.y + r.height; ++y) {
-    if (y == 0 || y + 1 == height_) {
-      for (int x = r.x; x < r.x + r.width; ++x) border(x, y);
-      continue;
-    }
-    interior(y);
-    for (int x = r.x; x < xa; ++x) border(x, y);
-    for (int x = std::max(xb, r.x); x < r.x + r.width; ++x) border(x, y);
-  }
   return rate;
 }
 

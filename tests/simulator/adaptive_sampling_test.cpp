@@ -9,8 +9,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <numbers>
 #include <iostream>
+#include <random>
+#include <vector>
 
 #include "evio/core/error.h"
 #include "evio/simulator/event_camera.h"
@@ -317,6 +321,68 @@ TEST(AdaptiveSampling, PerPixelSamplingKeepsTheAccuracyOfAFineWholeFrameStep) {
     EXPECT_LT(a.updates, esim_updates) << tile_px;
   }
   EXPECT_GT(ev_ref.size(), 20000u);
+}
+
+TEST(AdaptiveSampler, KthSmallestIsTheValueNthElementSelects) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> spread(0.0f, 50.0f);
+  std::uniform_int_distribution<int> level(0, 5);
+  for (const std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{17}, std::size_t{1000}, std::size_t{90000}}) {
+    // Rates as the predictor's: many exact zeros, repeated values, a long tail;
+    // a few negative values and −0 to check the ordering of the keys.
+    std::vector<float> values(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int l = level(rng);
+      values[i] = l == 0 ? 0.0f : l == 1 ? 3.5f : l == 2 ? -0.0f : spread(rng) * spread(rng);
+      if (i % 101 == 50) values[i] = -spread(rng);
+    }
+    const std::size_t step = n < 2000 ? 1 : 997;
+    for (std::size_t k = 0; k < n; k += step) {
+      std::vector<float> expected = values, scratch = values;
+      std::nth_element(expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(k), expected.end());
+      ASSERT_EQ(AdaptiveSampler::kthSmallest(&scratch, k), expected[k]) << "n " << n << " k " << k;
+    }
+    std::vector<float> scratch = values;
+    EXPECT_EQ(AdaptiveSampler::kthSmallest(&scratch, n - 1), *std::max_element(values.begin(), values.end()));
+  }
+  std::vector<float> none;
+  EXPECT_THROW(AdaptiveSampler::kthSmallest(&none, 0), Error);
+}
+
+TEST(AdaptiveSampler, LogRatesOfRowGivesTheBitsOfLogRateAt) {
+  // A log image and a flow with the awkward values: equal neighbours, NaN
+  // and infinite samples, zero, NaN, infinite and huge flow.
+  const int w = 37, h = 9;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  std::uniform_int_distribution<int> pick(0, 19);
+  cv::Mat log_image(h, w, CV_32FC1), flow(h, w, CV_32FC2);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int a = pick(rng), b = pick(rng);
+      log_image.at<float>(y, x) = a == 0 ? nan : a == 1 ? -inf : a < 5 ? 1.5f : u(rng);
+      flow.at<cv::Vec2f>(y, x) = b == 0   ? cv::Vec2f(nan, 1.0f)
+                                 : b == 1 ? cv::Vec2f(inf, 0.0f)
+                                 : b == 2 ? cv::Vec2f(0.0f, 0.0f)
+                                 : b == 3 ? cv::Vec2f(3e19f, -3e19f)
+                                          : cv::Vec2f(100.0f * u(rng), 100.0f * u(rng));
+    }
+  for (const bool bound : {true, false}) {
+    AdaptiveSampler::Options o;
+    o.rate_bound = bound;
+    const AdaptiveSampler sampler(o, 0.3, 1e-3);
+    for (int y = 0; y < h; ++y)
+      for (const auto& [x0, x1] : {std::pair{0, w}, std::pair{1, 30}, std::pair{5, 6}, std::pair{20, w}}) {
+        std::vector<float> rates(static_cast<std::size_t>(x1 - x0));
+        sampler.logRatesOfRow(log_image, flow, y, x0, x1, rates.data());
+        for (int x = x0; x < x1; ++x) {
+          const float expected = sampler.logRateAt(log_image, flow, x, y), got = rates[static_cast<std::size_t>(x - x0)];
+          ASSERT_EQ(std::memcmp(&got, &expected, sizeof(float)), 0)
+              << "x " << x << " y " << y << ": " << got << " vs " << expected << " (rate_bound " << bound << ")";
+        }
+      }
+  }
 }
 
 }  // namespace

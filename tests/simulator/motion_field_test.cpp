@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <random>
 
 #include "numeric_jacobian.h"
 
@@ -67,6 +71,52 @@ TEST(MotionField, FromDepthHandlesInfinityAndMissingPixels) {
   ASSERT_TRUE(cam.unproject(Vec2(5, 7), &b));
   ASSERT_TRUE(pointFlow(cam, b * (2.0 / b.z()), vel, &expected));
   EXPECT_NEAR(f.at<cv::Vec2f>(7, 5)[1], expected.y(), 1e-4);
+}
+
+/// The bits of a flow vector, signs of zero included.
+std::array<std::uint64_t, 2> bitsOf(const Vec2& f) {
+  std::array<std::uint64_t, 2> b{};
+  std::memcpy(b.data(), f.data(), sizeof(b));
+  return b;
+}
+
+TEST(MotionField, PinholeFlowGivesTheBitsOfTheGeneralFunctions) {
+  const PinholeCamera pinhole(346, 260, Vec4(259.4, 260.1, 172.3, 128.9));
+  const Camera cam = pinhole;
+  const PinholeFlow fast(pinhole);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_real_distribution<float> range(0.01f, 30.0f);
+  int compared = 0, rejected = 0;
+  for (int i = 0; i < 200000; ++i) {
+    // Velocities with zero components too (exact zeros in the sums).
+    CameraVelocity vel{Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng))};
+    if (i % 7 == 0) vel.v_C.x() = 0.0;
+    if (i % 11 == 0) vel.omega_C = Vec3::Zero();
+    if (i % 13 == 0) vel.v_C = Vec3::Zero();
+    // A pixel's bearing (float, as the renderer's) at a float range; some behind the camera.
+    const Eigen::Vector3f b = Vec3(u(rng), u(rng), i % 97 == 0 ? -0.5 : 1.0).normalized().cast<float>();
+    const Vec3 bd = b.cast<double>();
+    const Vec3 p = bd * static_cast<double>(range(rng));
+    Vec2 expected, got;
+    const bool ok_point = pointFlow(cam, p, vel, &expected);
+    ASSERT_EQ(fast.point(p, vel, &got), ok_point) << i;
+    if (ok_point) {
+      ASSERT_EQ(bitsOf(got), bitsOf(expected)) << i;
+      ++compared;
+    } else {
+      ++rejected;
+    }
+    const bool ok_direction = directionFlow(cam, bd, vel, &expected);
+    ASSERT_EQ(fast.direction(bd, vel, &got), ok_direction) << i;
+    if (ok_direction) {
+      ASSERT_EQ(bitsOf(got), bitsOf(expected)) << i;
+    }
+  }
+  EXPECT_GT(compared, 190000);
+  EXPECT_GT(rejected, 1000);
+  Vec2 f;
+  EXPECT_FALSE(fast.point(Vec3(0.0, 0.0, std::numeric_limits<double>::infinity()), CameraVelocity{}, &f));
 }
 
 }  // namespace

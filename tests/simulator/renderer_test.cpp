@@ -344,11 +344,13 @@ TEST(Renderer, Avx2PathRendersTheSameBitsAsTheBaselinePath) {
     base.avx2 = false;
     RendererOptions avx = base;
     avx.avx2 = true;
-    // A distorted camera, and a fisheye whose corners have no ray (NaN bearings).
+    // A pinhole camera (the 4-pixel flow path), a distorted camera, and a
+    // fisheye whose corners have no ray (NaN bearings).
     EquidistantCamera::Params fisheye;
     fisheye << 18.0, 18.0, 47.5, 35.5, -0.05, 0.0, 0.0, 0.0;
     const int w = tile == 8 ? 96 : 97, h = tile == 8 ? 72 : 71;
-    for (const Camera& cam : {radtan(w, h), Camera(EquidistantCamera(w, h, fisheye))}) {
+    const Camera pinhole = PinholeCamera(w, h, Vec4(60.0, 61.0, 0.5 * (w - 1), 0.5 * (h - 1)));
+    for (const Camera& cam : {pinhole, radtan(w, h), Camera(EquidistantCamera(w, h, fisheye))}) {
     const Renderer r_base(scene, cam, base), r_avx(scene, cam, avx);
     int no_ray = 0;
     for (int y = 0; y < cam.height(); ++y)

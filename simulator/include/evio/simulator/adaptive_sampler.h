@@ -70,6 +70,21 @@ class AdaptiveSampler {
   /// The predicted rate Ṙ (1/s) at pixel (x, y) of a log image and a CV_32FC2 motion field.
   float logRateAt(const cv::Mat& log_image, const cv::Mat& flow, int x, int y) const;
 
+  /// logImage of the pixels [x0, x1) of row y only, into *log_image (CV_32FC1
+  /// of the radiance's size).
+  void logRow(const cv::Mat& radiance, int y, int x0, int x1, cv::Mat* log_image) const;
+
+  /// logRateAt(log_image, flow, x, y) for x in [x0, x1) into rates[0 .. x1 − x0),
+  /// the same bits, on row pointers and without bounds tests for the pixels
+  /// away from the image border (the renderer's every step).
+  void logRatesOfRow(const cv::Mat& log_image, const cv::Mat& flow, int y, int x0, int x1, float* rates) const;
+
+  /// The k-th smallest of *values (0-based, k < size; NaN not allowed), the
+  /// value std::nth_element puts at k, by a radix pass over the top bits of
+  /// the floats and a selection among the few in the k-th's bin. *values is
+  /// the caller's scratch: its order changes.
+  static float kthSmallest(std::vector<float>* values, std::size_t k);
+
   /// The sample interval for a predicted |dL/dt| (1/s), ns, within the rate bounds.
   TimeNs interval(float log_rate) const;
 
@@ -92,6 +107,7 @@ class AdaptiveSampler {
   double threshold_ = 0.0;
   float log_eps_ = 0.0f;
   TimeNs min_interval_ns_ = 0, max_interval_ns_ = 0;
+  bool avx2_ = false;  ///< logRatesOfRow's interior eight pixels at a time (same bits)
 };
 
 }  // namespace evio::simulator

@@ -34,6 +34,47 @@ bool pointFlow(const Camera& camera, const Vec3& p_C, const CameraVelocity& velo
 /// u̇v (px/s) of a direction at infinity with unit bearing b_C.
 bool directionFlow(const Camera& camera, const Vec3& b_C, const CameraVelocity& velocity, Vec2* uv_dot);
 
+/// pointFlow and directionFlow of a pinhole camera, with the same float
+/// operations in the same order (so the same bits) but without the model
+/// dispatch, the pixel and the matrices the general functions compute: the
+/// renderer's flow of every pixel at every render.
+class PinholeFlow {
+ public:
+  explicit PinholeFlow(const PinholeCamera& camera) : fx_(camera.fx()), fy_(camera.fy()) {}
+
+  double fx() const { return fx_; }
+  double fy() const { return fy_; }
+
+  /// pointFlow(camera, p_C, velocity, uv_dot).
+  bool point(const Vec3& p_C, const CameraVelocity& velocity, Vec2* uv_dot) const {
+    if (!isInFrontOfCamera(p_C)) return false;
+    const Vec3 p_dot = -velocity.v_C - velocity.omega_C.cross(p_C);
+    return apply(p_C, p_dot, uv_dot);
+  }
+
+  /// directionFlow(camera, b_C, velocity, uv_dot).
+  bool direction(const Vec3& b_C, const CameraVelocity& velocity, Vec2* uv_dot) const {
+    if (!isInFrontOfCamera(b_C)) return false;
+    const Vec3 p_dot = -velocity.omega_C.cross(b_C);
+    return apply(b_C, p_dot, uv_dot);
+  }
+
+ private:
+  /// uv_dot = ∂π/∂p(p) · p_dot as PinholeCamera::project's Jacobian
+  /// (rows fx · ∂n/∂p and fy · ∂n/∂p of dNormalizedDPoint) times p_dot with
+  /// Eigen's association for a 2×3 by 3 product: (J₀ p₀ + J₁ p₁) + J₂ p₂.
+  bool apply(const Vec3& p, const Vec3& p_dot, Vec2* uv_dot) const {
+    const double z_inv = 1.0 / p.z();
+    const double a = p.x() * z_inv, b = p.y() * z_inv;
+    const double u0 = fx_ * z_inv, u1 = fx_ * 0.0, u2 = fx_ * (-a * z_inv);
+    const double v0 = fy_ * 0.0, v1 = fy_ * z_inv, v2 = fy_ * (-b * z_inv);
+    *uv_dot = Vec2((u0 * p_dot.x() + u1 * p_dot.y()) + u2 * p_dot.z(), (v0 * p_dot.x() + v1 * p_dot.y()) + v2 * p_dot.z());
+    return uv_dot->allFinite();
+  }
+
+  double fx_, fy_;  ///< focal lengths (px)
+};
+
 /// The motion field of a depth image (CV_32FC1, z in C in metres; +inf for
 /// rays that leave the scene; NaN for pixels without a ray): CV_32FC2 of
 /// (u̇, v̇) in px/s, NaN where undefined. Pixel (x, y) is unprojected at

@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
@@ -147,6 +148,21 @@ class Renderer {
   /// The output images of a tile from shadePacketsAvx2's results.
   void writeOutputs(int x0, int y0, int x1, int y1, const CameraVelocity* velocity, RenderOutput* out,
                     const Scratch& scratch) const;
+  /// The flow (px/s) of a pixel with unit bearing b (C): of the surface point
+  /// at `range` (m) along it when `hit`, else of the direction. False where
+  /// the camera cannot project it. Pinhole cameras take PinholeFlow (same bits).
+  bool pixelFlow(const Eigen::Vector3f& b, bool hit, float range, const CameraVelocity& velocity, Vec2* f) const {
+    const Vec3 bd = b.cast<double>();
+    if (pinhole_flow_)
+      return hit ? pinhole_flow_->point(bd * static_cast<double>(range), velocity, f)
+                 : pinhole_flow_->direction(bd, velocity, f);
+    return hit ? pointFlow(camera_, bd * static_cast<double>(range), velocity, f) : directionFlow(camera_, bd, velocity, f);
+  }
+  /// The flow of the pixels [x0, x1) of row y, whose rays are scratch's
+  /// r0, r0 + 1, ...: four at a time in double for a pinhole camera (the
+  /// bits of pixelFlow, renderer_avx2.cpp), pixel by pixel otherwise.
+  void flowRowAvx2(int y, int x0, int x1, std::size_t r0, const CameraVelocity& velocity, cv::Vec2f* flow,
+                   const Scratch& scratch) const;
   /// The body of both, inlined into each.
   template <bool kAvx2>
   void shadeTile(int tile, const Pose& T_W_C, const CameraVelocity* velocity, RenderOutput* out,
@@ -161,6 +177,12 @@ class Renderer {
   std::size_t tile_stride_ = 0;      ///< entries per column and tile: tile_px², rounded up to 8
   float pixel_angle_rad_ = 0.0f;              ///< ≈ 1 / fx, for the texture footprint
   bool avx2_ = false;                         ///< options_.avx2 and the CPU has AVX2
+  std::optional<PinholeFlow> pinhole_flow_;   ///< set when camera_ is a pinhole camera
+  /// Per pixel, pinhole cameras only: 1 when the bearing b is in front of
+  /// the camera with a margin (b_z > 2e-6 |b|, twice kMinCosAngle), so that
+  /// PinholeFlow's front test passes for b and for every b · range, range > 0
+  /// (flowRowAvx2 then needs no norm); 0: the pixel takes pixelFlow.
+  std::vector<std::uint8_t> flow_in_front_;
   std::shared_ptr<ScratchPool> scratch_;      ///< tile buffers (their contents do not outlive a tile)
 };
 

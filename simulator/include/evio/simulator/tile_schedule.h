@@ -69,7 +69,6 @@ class TileSchedule {
 
   int width_ = 0, height_ = 0, tile_px_ = 1, tiles_x_ = 0, tiles_y_ = 0;
   AdaptiveSampler sampler_;
-  float log_eps_ = 0.0f;
   TimeNs origin_ns_ = 0, quantum_ns_ = 0;
   int threads_ = 1;
   cv::Mat log_;               ///< L = log(ε + I) at each pixel's last sample (CV_32FC1)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <limits>
 #include <optional>
@@ -169,8 +170,12 @@ class EventStage {
     whole_ = false;
     t_ = t;
     rects_ = rects;
+    require(radiance.type() == CV_32FC1, "EventStage: radiance must be CV_32FC1");
     own_.create(radiance.size(), radiance.type());
-    for (const cv::Rect& r : rects_) radiance(r).copyTo(own_(r));
+    const cv::Rect image(0, 0, radiance.cols, radiance.rows);
+    for (const cv::Rect& r : rects_)
+      for (int y = r.y; y < r.y + r.height && (r & image) == r; ++y)  // (updateRects rejects the others)
+        std::memcpy(own_.ptr<float>(y) + r.x, radiance.ptr<float>(y) + r.x, static_cast<std::size_t>(r.width) * sizeof(float));
     radiance_ = own_;
     launch();
   }

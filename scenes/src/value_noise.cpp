@@ -25,6 +25,13 @@ ValueLattice::ValueLattice(std::uint64_t seed) : v_(static_cast<std::size_t>(kSi
   // 8-bit levels in [−1, 1], as a compact table would hold them.
   for (auto& x : v_) x = static_cast<std::int8_t>(static_cast<int>(rng.uniformInt(255)) - 127);
   v_.resize(v_.size() + 3, 0);  // 4-byte gathers at the last entry stay inside
+  // Rows of kSize + 1 entries, the last one a copy of the row's first (x = 0
+  // follows x = kSize − 1): one 4-byte gather at x holds the values at x and
+  // at x + 1 (mod kSize). + 3 bytes: the gathers at the last entry stay inside.
+  constexpr std::size_t kRow = kSize + 1;
+  pairs_.assign(kRow * kSize * kSize + 3, 0);
+  for (std::size_t zy = 0; zy < static_cast<std::size_t>(kSize * kSize); ++zy)
+    for (std::size_t x = 0; x < kRow; ++x) pairs_[zy * kRow + x] = v_[zy * kSize + x % kSize];
 #if defined(EVIO_VALUE_NOISE_AVX2)
   avx2_ = cpuHasAvx2();
 #endif
@@ -112,17 +119,29 @@ void ValueLattice::octaveValues(const Eigen::Vector3f& p, int first, int count, 
 
 #if defined(EVIO_VALUE_NOISE_AVX2)
 namespace {
-/// The lattice values at indices z + y + x: 4 bytes read at each, the first
-/// (little endian) kept, sign-extended.
-EVIO_AVX2_INLINE __m256 gatherValues(const int* base, __m256i z, __m256i y, __m256i x) {
-  const __m256i g = _mm256_i32gather_epi32(base, _mm256_add_epi32(z, _mm256_add_epi32(y, x)), 1);
-  return _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(g, 24), 24));
+/// The lattice values at x and x + 1 (mod kSize) of the row at offset zy of
+/// the paired table (ValueLattice::pairs_): the first two of the 4 bytes read
+/// at zy + x, sign-extended.
+struct ValuePair {
+  __m256 lo, hi;
+};
+EVIO_AVX2_INLINE ValuePair gatherPair(const int* pairs, __m256i zy, __m256i x) {
+  const __m256i g = _mm256_i32gather_epi32(pairs, _mm256_add_epi32(zy, x), 1);
+  return {_mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(g, 24), 24)),
+          _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(g, 16), 24))};
+}
+
+/// Offsets of row y (y · 65) and of slice z (z · 65 · 64) in the paired table.
+EVIO_AVX2_INLINE __m256i pairedRow(__m256i y) { return _mm256_add_epi32(_mm256_slli_epi32(y, 6), y); }
+EVIO_AVX2_INLINE __m256i pairedSlice(__m256i z) {
+  return _mm256_add_epi32(_mm256_slli_epi32(z, 12), _mm256_slli_epi32(z, 6));
 }
 
 /// ValueLattice::value at eight points q (lattice units), lane by lane the
 /// float operations of value() in its order (detail::floorInt, detail::fade,
-/// seven interpolations, × 1/127).
-EVIO_AVX2_INLINE __m256 latticeValue8(const __m256 (&q)[3], const int* base) {
+/// seven interpolations, × 1/127), the values read from the paired table:
+/// four gathers of two neighbours along x each.
+EVIO_AVX2_INLINE __m256 latticeValue8(const __m256 (&q)[3], const int* pairs) {
   const __m256i m = _mm256_set1_epi32(ValueLattice::kSize - 1), one = _mm256_set1_epi32(1);
   __m256i lo[3], hi[3];
   __m256 f[3];
@@ -139,15 +158,16 @@ EVIO_AVX2_INLINE __m256 latticeValue8(const __m256 (&q)[3], const int* base) {
     hi[i] = _mm256_and_si256(_mm256_add_epi32(ix, one), m);
   }
   static_assert(ValueLattice::kSize == 64, "the shifts below assume a 64-cell lattice");
-  lo[1] = _mm256_slli_epi32(lo[1], 6);
-  hi[1] = _mm256_slli_epi32(hi[1], 6);
-  lo[2] = _mm256_slli_epi32(lo[2], 12);
-  hi[2] = _mm256_slli_epi32(hi[2], 12);
+  const __m256i y0 = pairedRow(lo[1]), y1 = pairedRow(hi[1]), z0 = pairedSlice(lo[2]), z1 = pairedSlice(hi[2]);
   using scenes::avx2::lerp;
-  const __m256 a00 = lerp(gatherValues(base, lo[2], lo[1], lo[0]), gatherValues(base, lo[2], lo[1], hi[0]), f[0]);
-  const __m256 a10 = lerp(gatherValues(base, lo[2], hi[1], lo[0]), gatherValues(base, lo[2], hi[1], hi[0]), f[0]);
-  const __m256 a01 = lerp(gatherValues(base, hi[2], lo[1], lo[0]), gatherValues(base, hi[2], lo[1], hi[0]), f[0]);
-  const __m256 a11 = lerp(gatherValues(base, hi[2], hi[1], lo[0]), gatherValues(base, hi[2], hi[1], hi[0]), f[0]);
+  const ValuePair p00 = gatherPair(pairs, _mm256_add_epi32(z0, y0), lo[0]);
+  const ValuePair p10 = gatherPair(pairs, _mm256_add_epi32(z0, y1), lo[0]);
+  const ValuePair p01 = gatherPair(pairs, _mm256_add_epi32(z1, y0), lo[0]);
+  const ValuePair p11 = gatherPair(pairs, _mm256_add_epi32(z1, y1), lo[0]);
+  const __m256 a00 = lerp(p00.lo, p00.hi, f[0]);
+  const __m256 a10 = lerp(p10.lo, p10.hi, f[0]);
+  const __m256 a01 = lerp(p01.lo, p01.hi, f[0]);
+  const __m256 a11 = lerp(p11.lo, p11.hi, f[0]);
   return _mm256_mul_ps(lerp(lerp(a00, a10, f[1]), lerp(a01, a11, f[1]), f[2]), _mm256_set1_ps(1.0f / 127.0f));
 }
 }  // namespace
@@ -164,13 +184,13 @@ EVIO_AVX2 void ValueLattice::octaveValues8(const Eigen::Vector3f& p, int first, 
                                                      _mm256_mul_ps(_mm256_loadu_ps(&rotation_soa_[3 * i + 2][k]), pz))),
                          _mm256_loadu_ps(&offset_soa_[i][k]));
   alignas(32) float all[8];
-  _mm256_store_ps(all, latticeValue8(q, reinterpret_cast<const int*>(v_.data())));
+  _mm256_store_ps(all, latticeValue8(q, reinterpret_cast<const int*>(pairs_.data())));
   for (int j = 0; j < count; ++j) out[j] = all[j];
 }
 
 EVIO_AVX2 void ValueLattice::value8Avx2(const float* x, const float* y, const float* z, float* out) const {
   const __m256 q[3] = {_mm256_loadu_ps(x), _mm256_loadu_ps(y), _mm256_loadu_ps(z)};
-  _mm256_storeu_ps(out, latticeValue8(q, reinterpret_cast<const int*>(v_.data())));
+  _mm256_storeu_ps(out, latticeValue8(q, reinterpret_cast<const int*>(pairs_.data())));
 }
 
 EVIO_AVX2 void ValueLattice::fbm8Avx2(const float* x, const float* y, const float* z, int octaves, float gain,
@@ -189,7 +209,7 @@ EVIO_AVX2 void ValueLattice::fbm8Avx2(const float* x, const float* y, const floa
                                   _mm256_cmp_ps(fp, _mm256_setzero_ps(), _CMP_GT_OQ));
   __m256 active = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
   __m256 sum = _mm256_setzero_ps();
-  const auto* base = reinterpret_cast<const int*>(v_.data());
+  const auto* base = reinterpret_cast<const int*>(pairs_.data());
   float amp = 1.0f;
   for (int o = 0; o < octaves; ++o, ratio = _mm256_mul_ps(ratio, half), amp *= gain) {
     active = _mm256_and_ps(active, _mm256_cmp_ps(ratio, four, _CMP_NLE_UQ));  // fbm stops at ratio <= 4

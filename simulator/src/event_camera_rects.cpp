@@ -26,25 +26,35 @@ void EventCamera::updateRects(TimeNs t_ns, const std::vector<cv::Rect>& rects, c
     uniform_ = false;
   }
   const cv::Rect image(0, 0, width_, height_);
+  for (const cv::Rect& r : rects)
+    if ((r & image) != r) throw Error("EventCamera::updateRects: a rectangle is not inside the image");
   // Runs of one row, [begin, end) pixel indices, checked before any change.
+  // Consecutive rectangles on the same rows (a row of tiles, given left to
+  // right) give their runs row by row, so that runs_ comes out sorted and
+  // needs no sort when the rectangles come in row-major order.
   runs_.clear();
   std::size_t count = 0;
-  for (const cv::Rect& r : rects) {
-    if ((r & image) != r) throw Error("EventCamera::updateRects: a rectangle is not inside the image");
-    for (int y = r.y; y < r.y + r.height; ++y) {
-      const std::size_t begin = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
-                                static_cast<std::size_t>(r.x);
-      runs_.emplace_back(begin, begin + static_cast<std::size_t>(r.width));
-      TimeNs latest = std::numeric_limits<TimeNs>::min();  // the run's latest sample
-      for (std::size_t i = begin; i < begin + static_cast<std::size_t>(r.width); ++i) latest = std::max(latest, t_prev_[i]);
-      if (t_ns <= latest)
-        throw Error("EventCamera::updateRects: time " + std::to_string(t_ns) + " ns is not after the last sample " +
-                    std::to_string(latest) + " ns of a pixel in row " + std::to_string(y));
-      count += static_cast<std::size_t>(r.width);
-    }
+  for (std::size_t g = 0; g < rects.size();) {
+    std::size_t g_end = g + 1;
+    while (g_end < rects.size() && rects[g_end].y == rects[g].y && rects[g_end].height == rects[g].height) ++g_end;
+    for (int y = rects[g].y; y < rects[g].y + rects[g].height; ++y)
+      for (std::size_t k = g; k < g_end; ++k) {
+        const cv::Rect& r = rects[k];
+        const std::size_t begin = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                                  static_cast<std::size_t>(r.x);
+        runs_.emplace_back(begin, begin + static_cast<std::size_t>(r.width));
+        TimeNs latest = std::numeric_limits<TimeNs>::min();  // the run's latest sample
+        for (std::size_t i = begin; i < begin + static_cast<std::size_t>(r.width); ++i)
+          latest = std::max(latest, t_prev_[i]);
+        if (t_ns <= latest)
+          throw Error("EventCamera::updateRects: time " + std::to_string(t_ns) + " ns is not after the last sample " +
+                      std::to_string(latest) + " ns of a pixel in row " + std::to_string(y));
+        count += static_cast<std::size_t>(r.width);
+      }
+    g = g_end;
   }
+  if (!std::is_sorted(runs_.begin(), runs_.end())) std::sort(runs_.begin(), runs_.end());
   // Runs that touch (tiles side by side) become one: fewer, longer vector loops.
-  std::sort(runs_.begin(), runs_.end());
   std::size_t merged = 0;
   for (std::size_t k = 0; k < runs_.size(); ++k) {
     if (merged > 0 && runs_[k].first < runs_[merged - 1].second)

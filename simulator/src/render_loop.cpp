@@ -1,7 +1,11 @@
 #include "render_loop.h"
 
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <exception>
 #include <limits>
 #include <optional>
 
@@ -111,9 +115,136 @@ struct FrameInProgress {
   TimeNs next() const { return sample_ns[images.size()]; }
 };
 
+/// f() on the calling thread in the simulator's arena, isolated: while it
+/// waits for its own parallel loops the thread runs none of the arena's
+/// other tasks (an event stage that another thread would start, below), so
+/// the render or schedule it runs is not held up by one.
+template <class F>
+void isolated(int threads, const F& f) {
+  if (threads == 1) {
+    f();
+    return;
+  }
+  sharedArena(threads).execute([&] { tbb::this_task_arena::isolate([&] { f(); }); });
+}
+
+/// The event stage of a step: the event camera fed with the step's pixels
+/// (update for a whole render, updateRects for the tiles due) and its events
+/// handed to the writer. With more than one thread it runs as a task in the
+/// simulator's TBB arena while the calling thread goes on with the next
+/// step's schedule and render (nothing of which reads the event camera);
+/// the next launch waits for it. The events and the camera's state are
+/// those of the serial order: one stage at a time, in step order.
+class EventStage {
+ public:
+  EventStage(EventCamera* camera, AsyncSequenceWriter* writer, int threads)
+      : camera_(*camera), writer_(*writer), threads_(threads) {}
+  ~EventStage() {
+    try {
+      wait();
+    } catch (...) {  // unwinding already, or the error was reported
+    }
+  }
+  EventStage(const EventStage&) = delete;
+  EventStage& operator=(const EventStage&) = delete;
+
+  /// Every pixel sampled at t. With copy, `radiance` is copied first;
+  /// without, it must not change until the stage has ended (the next
+  /// launch or wait()).
+  void launchWhole(TimeNs t, const cv::Mat& radiance, bool copy) {
+    wait();
+    whole_ = true;
+    t_ = t;
+    if (copy) {
+      radiance.copyTo(own_);
+      radiance_ = own_;
+    } else {
+      radiance_ = radiance;
+    }
+    launch();
+  }
+  /// The pixels of `rects` sampled at t; they are copied out of `radiance`
+  /// first (only they), so it may change as soon as this returns.
+  void launchRects(TimeNs t, const std::vector<cv::Rect>& rects, const cv::Mat& radiance) {
+    wait();
+    whole_ = false;
+    t_ = t;
+    rects_ = rects;
+    require(radiance.type() == CV_32FC1, "EventStage: radiance must be CV_32FC1");
+    own_.create(radiance.size(), radiance.type());
+    const cv::Rect image(0, 0, radiance.cols, radiance.rows);
+    for (const cv::Rect& r : rects_)
+      for (int y = r.y; y < r.y + r.height && (r & image) == r; ++y)  // (updateRects rejects the others)
+        std::memcpy(own_.ptr<float>(y) + r.x, radiance.ptr<float>(y) + r.x, static_cast<std::size_t>(r.width) * sizeof(float));
+    radiance_ = own_;
+    launch();
+  }
+  /// Waits for the running stage; rethrows its error.
+  void wait() {
+    if (running_) {
+      sharedArena(threads_).execute([this] { group_.wait(); });
+      running_ = false;
+    }
+    radiance_.release();
+    if (error_) {
+      const std::exception_ptr e = error_;
+      error_ = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+
+  double event_s = 0.0, event_cpu_s = 0.0, write_s = 0.0;  ///< wall time, CPU time of the running thread, queueing
+
+ private:
+  void launch() {
+    if (threads_ == 1) {
+      run();
+      wait();  // releases the image; rethrows an error
+      return;
+    }
+    running_ = true;
+    sharedArena(threads_).execute([this] { group_.run([this] { run(); }); });
+  }
+  void run() {
+    try {
+      Stopwatch watch;
+      const double cpu0_s = Stopwatch::threadCpuSeconds();
+      batch_.clear();
+      labels_.clear();
+      if (whole_) {
+        camera_.update(t_, radiance_, &batch_, &labels_);
+      } else {
+        camera_.updateRects(t_, rects_, radiance_);
+        camera_.emit(&batch_, &labels_);
+      }
+      event_s += watch.seconds();
+      event_cpu_s += Stopwatch::threadCpuSeconds() - cpu0_s;
+      watch.restart();
+      writer_.appendEvents(batch_, labels_);
+      write_s += watch.seconds();
+    } catch (...) {
+      error_ = std::current_exception();
+    }
+  }
+
+  EventCamera& camera_;
+  AsyncSequenceWriter& writer_;
+  int threads_;
+  tbb::task_group group_;
+  bool running_ = false;
+  std::exception_ptr error_;
+  bool whole_ = true;
+  TimeNs t_ = 0;
+  std::vector<cv::Rect> rects_;
+  cv::Mat radiance_;  ///< the stage's input image while it runs
+  cv::Mat own_;       ///< the copied pixels (tile schedule)
+  EventArray batch_;
+  std::vector<EventLabel> labels_;
+};
+
 }  // namespace
 
-RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& scene, SequenceWriter& writer,
+RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& scene, AsyncSequenceWriter& writer,
                                const ProgressCallback& progress, SimulationStats* stats) {
   const ScenarioOptions& o = scenario.options;
   const auto& fo = o.rig.frame_camera;
@@ -195,7 +326,8 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
     frame->images.push_back(radiance);
     if (frame->images.size() < frame->sample_ns.size()) return;
     Stopwatch watch;
-    const Frame captured = frame_cam->capture(frame->start_ns, frame->images);
+    Frame captured;
+    isolated(o.threads, [&] { captured = frame_cam->capture(frame->start_ns, frame->images); });
     stats->frame_s += watch.seconds();
     watch.restart();
     writer.appendFrame(captured.t_ns, captured.image);
@@ -205,72 +337,59 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   };
 
   RenderLoopResult result;
-  EventArray batch;
-  std::vector<EventLabel> labels;
   TimeNs next_event = scenario.start_ns;  // the next whole-frame step ("whole_frame")
   TimeNs last_t = kNever;
-  RenderOutput last;                      // the latest sample of every pixel
+  // The latest sample of every pixel: *last. The whole-frame schedule
+  // renders into the two buffers in turn, so that the event stage of one
+  // render reads its image while the next render fills the other; the tile
+  // schedule keeps one (a step re-traces only some tiles of it).
+  RenderOutput buffers[2];
+  RenderOutput* last = &buffers[0];
   std::vector<int> due_tiles;
   std::vector<cv::Rect> due_rects;
-  const auto writeBatch = [&] {
-    const Stopwatch watch;
-    writer.appendEvents(batch, labels);
-    stats->write_s += watch.seconds();
-  };
+  EventStage event_stage(&events_cam, &writer, o.threads);
   // Every pixel sampled at t: a whole render, EventCamera::update (which
   // emits every event up to t), and the next step predicted from it.
   const auto wholeStep = [&](TimeNs t, const Pose& T_W_E, const CameraVelocity& velocity) {
+    if (!tile_mode) last = last == &buffers[0] ? &buffers[1] : &buffers[0];
     Stopwatch watch;
-    double cpu0_s = Stopwatch::processCpuSeconds();
-    renderer.render(T_W_E, &velocity, &last);  // reuses last's images unless they are shared
+    const double cpu0_s = Stopwatch::processCpuSeconds();
+    isolated(o.threads, [&] { renderer.render(T_W_E, &velocity, last); });  // reuses last's images unless shared
     stats->render_s += watch.seconds();
     stats->render_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
     ++stats->renders;
     stats->tiles_rendered += stats->tile_count;
 
-    watch.restart();
-    cpu0_s = Stopwatch::processCpuSeconds();
-    batch.clear();
-    labels.clear();
-    events_cam.update(t, last.radiance, &batch, &labels);
-    stats->event_s += watch.seconds();
-    stats->event_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
-    writeBatch();
+    event_stage.launchWhole(t, last->radiance, tile_mode);  // after the previous step's stage
 
     watch.restart();
-    if (tile_mode) {
-      tile_schedule->scheduleAll(t, last.radiance, last.flow);
-    } else if (t < scenario.end_ns) {  // the next step, predicted from this (latest) sample
-      next_event = t + predictor.interval(last.radiance, last.flow);
-    }
+    isolated(o.threads, [&] {
+      if (tile_mode) {
+        tile_schedule->scheduleAll(t, last->radiance, last->flow);
+      } else if (t < scenario.end_ns) {  // the next step, predicted from this (latest) sample
+        next_event = t + predictor.interval(last->radiance, last->flow);
+      }
+    });
     stats->schedule_s += watch.seconds();
   };
   // The tiles due at t only: renderTiles, their pixels to the event camera,
   // the events up to the watermark (the earliest last sample of any pixel).
   const auto tileStep = [&](TimeNs t, const Pose& T_W_E, const CameraVelocity& velocity) {
     Stopwatch watch;
-    double cpu0_s = Stopwatch::processCpuSeconds();
+    const double cpu0_s = Stopwatch::processCpuSeconds();
     tile_schedule->dueTiles(t, &due_tiles);
-    renderer.renderTiles(T_W_E, &velocity, due_tiles.data(), due_tiles.size(), &last);
+    isolated(o.threads, [&] { renderer.renderTiles(T_W_E, &velocity, due_tiles.data(), due_tiles.size(), last); });
     stats->render_s += watch.seconds();
     stats->render_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
     ++stats->tile_steps;
     stats->tiles_rendered += due_tiles.size();
 
-    watch.restart();
-    cpu0_s = Stopwatch::processCpuSeconds();
     due_rects.clear();
     for (const int k : due_tiles) due_rects.push_back(renderer.tileRect(k));
-    events_cam.updateRects(t, due_rects, last.radiance);
-    batch.clear();
-    labels.clear();
-    events_cam.emit(&batch, &labels);
-    stats->event_s += watch.seconds();
-    stats->event_cpu_s += Stopwatch::processCpuSeconds() - cpu0_s;
-    writeBatch();
+    event_stage.launchRects(t, due_rects, last->radiance);
 
     watch.restart();
-    tile_schedule->scheduleTiles(t, due_tiles, last.radiance, last.flow);
+    isolated(o.threads, [&] { tile_schedule->scheduleTiles(t, due_tiles, last->radiance, last->flow); });
     stats->schedule_s += watch.seconds();
   };
 
@@ -305,15 +424,15 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
         tileStep(t, T_W_E, velocity);
       }
       if (last_t == kNever) {
-        result.first_depth = last.depth.clone();
+        result.first_depth = last->depth.clone();
         result.first_T_W_E = T_W_E;
       }
       last_t = t;
     }
-    if (!separate && frame && t == t_frame) addSample(last.radiance);
+    if (!separate && frame && t == t_frame) addSample(last->radiance);
     if (frame && t == t_depth) {
       const Stopwatch watch;
-      writer.appendDepth(frame->index, t, last.depth, o.output.flow_at_frames ? last.flow : cv::Mat());
+      writer.appendDepth(frame->index, t, last->depth, o.output.flow_at_frames ? last->flow : cv::Mat());
       stats->write_s += watch.seconds();
       frame->depth_done = true;
     }
@@ -322,6 +441,10 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
                                   stats->tiles_rendered});
     if (t >= scenario.end_ns) break;
   }
+  event_stage.wait();
+  stats->event_s += event_stage.event_s;
+  stats->event_cpu_s += event_stage.event_cpu_s;
+  stats->write_s += event_stage.write_s;
   stats->pixel_updates = events_cam.pixelUpdates();
   return result;
 }

@@ -3,8 +3,10 @@
 // "Render scheduling"): renders the event camera at adaptive whole-frame
 // steps or, with sampling.schedule "tiles", re-renders only the tiles due
 // (tile_schedule.h); whole renders at frame sub-samples, frame stamps and the
-// end; feeds the event camera, the frame camera and the SequenceWriter in
-// time order.
+// end; feeds the event camera, the frame camera and the writer in time
+// order. The event stage of a step (event camera, events to the writer)
+// runs while the next step is scheduled and rendered (render_loop.cpp,
+// EventStage).
 
 #include <opencv2/core/mat.hpp>
 
@@ -23,7 +25,7 @@ struct RenderLoopResult {
 
 /// Runs the loop over [scenario.start_ns, scenario.end_ns]; adds counts and
 /// stage times to *stats.
-RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& scene, SequenceWriter& writer,
+RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& scene, AsyncSequenceWriter& writer,
                                const ProgressCallback& progress, SimulationStats* stats);
 
 }  // namespace evio::simulator

@@ -88,19 +88,12 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
   const scenes::SurfaceHitColumns& c = s.columns;
 
   // Albedo: footprints (as the scalar path), the hits grouped by material.
-  const auto materials = static_cast<std::size_t>(scene_.materialCount());
   s.footprint.resize(padded);
   s.material.assign(padded, 0);
   s.albedo.assign(padded, 0.0f);
   footprints8(padded, footprint_scale, s.rays.data(), c, s.dx.data(), s.dy.data(), s.dz.data(), s.footprint.data());
-  bool one_material = true;  // every hit of the tile has the same material
-  int first_material = -1;
-  for (std::size_t r = 0; r < rays; ++r) {
-    if (!hit(r)) continue;
-    s.material[r] = scene_.materialOf(c.mesh[r]);
-    if (first_material < 0) first_material = s.material[r];
-    one_material = one_material && s.material[r] == first_material;
-  }
+  for (std::size_t r = 0; r < rays; ++r)
+    if (hit(r)) s.material[r] = scene_.materialOf(c.mesh[r]);
   alignas(32) float px[8], py[8], pz[8], u[8], v[8], fp[8], albedo[8];
   // Eight hits of material m, rays[i] for i < n (the rest repeat the last).
   const auto gathered = [&](int m, const std::uint32_t* rays_of, std::uint32_t n) {
@@ -116,23 +109,30 @@ std::uint64_t Renderer::shadePacketsAvx2(std::size_t rays, float footprint_scale
     scene_.albedo8Avx2(m, px, py, pz, u, v, fp, albedo);
     for (std::uint32_t k = 0; k < n; ++k) s.albedo[rays_of[k]] = albedo[k];
   };
-  if (one_material && first_material >= 0) {
-    // The common case: a group of eight hits goes to the texture as it is.
-    std::uint32_t group[8];
-    for (std::size_t at = 0; at < padded; at += kLanes) {
-      const int mask = s.hit_mask[at / kLanes];
-      if (mask == 0xff) {
-        scene_.albedo8Avx2(first_material, c.px.data() + at, c.py.data() + at, c.pz.data() + at, c.u.data() + at,
+  // Group by group of eight rays: eight hits of one material go to the
+  // texture as they are, the hits of a group that some rays missed or that
+  // holds several materials are gathered material by material (each lane's
+  // albedo depends on its own ray only, so any grouping gives the same values).
+  std::uint32_t group[8];
+  for (std::size_t at = 0; at < padded; at += kLanes) {
+    int left = s.hit_mask[at / kLanes];
+    while (left != 0) {
+      const int m = s.material[at + static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(left)))];
+      std::uint32_t n = 0;
+      int lanes = 0;
+      for (std::size_t j = 0; j < kLanes; ++j)
+        if (((left >> j) & 1) && s.material[at + j] == m) {
+          group[n++] = static_cast<std::uint32_t>(at + j);
+          lanes |= 1 << j;
+        }
+      left &= ~lanes;
+      if (lanes == 0xff) {
+        scene_.albedo8Avx2(m, c.px.data() + at, c.py.data() + at, c.pz.data() + at, c.u.data() + at,
                            c.v.data() + at, s.footprint.data() + at, s.albedo.data() + at);
-      } else if (mask != 0) {
-        std::uint32_t n = 0;
-        for (std::size_t j = 0; j < kLanes; ++j)
-          if ((mask >> j) & 1) group[n++] = static_cast<std::uint32_t>(at + j);
-        gathered(first_material, group, n);
+      } else {
+        gathered(m, group, n);
       }
     }
-  } else {
-    forMaterialGroups(rays, materials, s, hit, gathered);
   }
 
 

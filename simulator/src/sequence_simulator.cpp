@@ -255,7 +255,7 @@ SimulationStats simulateSequence(const Scenario& scenario, const std::string& fo
   wo.events_h5_compression = o.output.events_h5_compression;
   wo.frames = o.rig.frame_camera.enabled;
   wo.depth = o.rig.frame_camera.enabled && o.output.depth_at_frames;
-  SequenceWriter writer(folder, wo);
+  AsyncSequenceWriter writer(folder, wo);  // writes on a thread of its own while the loop renders
   const RenderLoopResult first = runRenderLoop(scenario, scene, writer, progress, &stats);
   watch.restart();
   for (auto& f : writer.close()) stats.files.push_back(f);

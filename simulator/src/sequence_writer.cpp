@@ -87,4 +87,63 @@ std::vector<std::string> SequenceWriter::close() {
   return files_;
 }
 
+AsyncSequenceWriter::AsyncSequenceWriter(const std::string& folder, const SequenceWriterOptions& options,
+                                         std::size_t queue_slots)
+    : options_(options), writer_(folder, options), thread_(queue_slots, [this](Job& job) { write(job); }) {}
+
+void AsyncSequenceWriter::write(Job& job) {
+  switch (job.kind) {
+    case Job::Kind::kEvents:
+      writer_.appendEvents(job.events, job.labels);
+      return;
+    case Job::Kind::kFrame:
+      writer_.appendFrame(job.t_ns, job.image);
+      return;
+    case Job::Kind::kDepth:
+      writer_.appendDepth(job.index, job.t_ns, job.depth, job.flow);
+      return;
+  }
+}
+
+void AsyncSequenceWriter::appendEvents(const EventArray& events, const std::vector<EventLabel>& labels) {
+  require(labels.size() == events.size(), "SequenceWriter: one label per event");
+  if (events.empty()) return;
+  thread_.push([&](Job& job) {
+    job.kind = Job::Kind::kEvents;
+    job.events = events;  // copy assignment: reuses the slot's capacity
+    job.labels = labels;
+  });
+  events_.fetch_add(events.size(), std::memory_order_relaxed);
+}
+
+std::size_t AsyncSequenceWriter::appendFrame(TimeNs t_ns, const cv::Mat& image) {
+  require(options_.frames, "SequenceWriter: frames are off");
+  thread_.push([&](Job& job) {
+    job.kind = Job::Kind::kFrame;
+    job.t_ns = t_ns;
+    image.copyTo(job.image);  // reuses the slot's buffer when the size and type match
+  });
+  return static_cast<std::size_t>(frames_.fetch_add(1, std::memory_order_relaxed));
+}
+
+void AsyncSequenceWriter::appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth, const cv::Mat& flow) {
+  thread_.push([&](Job& job) {
+    job.kind = Job::Kind::kDepth;
+    job.index = index;
+    job.t_ns = t_ns;
+    depth.copyTo(job.depth);
+    if (flow.empty()) {
+      job.flow.release();
+    } else {
+      flow.copyTo(job.flow);
+    }
+  });
+  depths_.fetch_add(1, std::memory_order_relaxed);
+}
+
+std::vector<std::string> AsyncSequenceWriter::close() {
+  thread_.finish();
+  return writer_.close();
+}
+
 }  // namespace evio::simulator

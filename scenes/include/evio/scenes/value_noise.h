@@ -61,6 +61,9 @@ class ValueLattice {
   bool avx2_ = false;  ///< the CPU has AVX2 (x86-64 GCC/Clang builds check at construction)
 
   std::vector<std::int8_t> v_;  ///< kSize³ values × 127, x fastest (256 KiB: stays in cache), + 3 bytes of padding
+  /// The same values in rows of kSize + 1 (x = kSize repeats x = 0), + 3
+  /// bytes of padding: the AVX2 lookups read both x neighbours in one gather.
+  std::vector<std::int8_t> pairs_;
   std::array<Eigen::Matrix3f, kMaxOctaves> rotation_;  ///< 2^o R_o
   std::array<Eigen::Vector3f, kMaxOctaves> offset_;
   /// The same, one row per matrix entry (3 i + j) or offset component,

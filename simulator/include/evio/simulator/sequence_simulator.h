@@ -37,9 +37,11 @@
 /// straight from the trajectory and the scene.
 ///
 /// Determinism: the renderer, the event camera and the frame camera give
-/// results independent of the thread count, everything else runs on one
-/// thread in a fixed order, so the same scenario and seed give byte-identical
-/// files (simulation_stats.yaml aside) whatever `threads` is.
+/// results independent of the thread count, everything else runs in a fixed
+/// order (the event stage of a step, overlapped with the next render, one
+/// stage at a time; each file written by one thread in order), so the same
+/// scenario and seed give byte-identical files (simulation_stats.yaml aside)
+/// whatever `threads` is.
 
 #include <cstdint>
 #include <functional>
@@ -68,12 +70,12 @@ struct SimulationStats {
   double scene_build_s = 0.0;
   double render_s = 0.0;             ///< event-camera renders (flow included)
   double frame_render_s = 0.0;       ///< separate frame-camera renders
-  double event_s = 0.0;              ///< EventCamera::update
+  double event_s = 0.0;              ///< event stage (EventCamera update/emit); overlaps the renders with 2+ threads
   double schedule_s = 0.0;           ///< adaptive step prediction
   double frame_s = 0.0;              ///< FrameCamera::capture
-  double write_s = 0.0;              ///< writing events, frames, depth
-  double render_cpu_s = 0.0;         ///< CPU time (all threads) of the event-camera renders
-  double event_cpu_s = 0.0;          ///< CPU time (all threads) of EventCamera::update
+  double write_s = 0.0;              ///< handing events, frames, depth to the writer thread, and closing the files
+  double render_cpu_s = 0.0;         ///< process CPU time during the event-camera renders (an overlapping event stage included)
+  double event_cpu_s = 0.0;          ///< CPU time of the thread that ran each event stage
   double truth_s = 0.0;              ///< ground truth, IMU, range, tracks passes
   int width = 0, height = 0;         ///< event sensor, px
   std::string schedule;              ///< sampling.schedule: whole_frame or tiles

@@ -14,6 +14,7 @@
 ///                             `t depth/depth_XXXXXXXX.exr` like images.txt
 /// Each file appears under its name only when complete (close()).
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -28,6 +29,7 @@
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/images_txt.h"
 #include "evio/simulator/event_camera.h"
+#include "evio/simulator/writer_thread.h"
 
 namespace evio::simulator {
 
@@ -70,6 +72,46 @@ class SequenceWriter {
   std::vector<std::string> files_;
   std::vector<std::uint8_t> label_bytes_;
   std::uint64_t events_ = 0, frames_ = 0, depths_ = 0;
+};
+
+/// A SequenceWriter on a thread of its own (writer_thread.h): the same calls
+/// write the same files, but an append only copies its data into one of
+/// `queue_slots` reusable slots (waiting while all are queued) and returns,
+/// so the files are written while the caller renders. The arguments are
+/// checked at once; an error of the writing itself surfaces at a later
+/// append or at close(), and the files are then not completed (as when
+/// SequenceWriter throws). Appends may come from several threads; each
+/// file's data must come from one thread (events from one, frames from one).
+class AsyncSequenceWriter {
+ public:
+  AsyncSequenceWriter(const std::string& folder, const SequenceWriterOptions& options, std::size_t queue_slots = 16);
+
+  void appendEvents(const EventArray& events, const std::vector<EventLabel>& labels);
+  std::size_t appendFrame(TimeNs t_ns, const cv::Mat& image);
+  void appendDepth(std::size_t index, TimeNs t_ns, const cv::Mat& depth, const cv::Mat& flow = cv::Mat());
+  /// Waits for the queued writes, then closes every file (SequenceWriter::close).
+  std::vector<std::string> close();
+
+  std::uint64_t eventCount() const { return events_.load(std::memory_order_relaxed); }
+  std::uint64_t frameCount() const { return frames_.load(std::memory_order_relaxed); }
+  std::uint64_t depthCount() const { return depths_.load(std::memory_order_relaxed); }
+
+ private:
+  /// One queued write; its buffers are reused by later writes.
+  struct Job {
+    enum class Kind { kEvents, kFrame, kDepth } kind = Kind::kEvents;
+    EventArray events;
+    std::vector<EventLabel> labels;
+    TimeNs t_ns = 0;
+    std::size_t index = 0;
+    cv::Mat image, depth, flow;  ///< kFrame: image; kDepth: depth, flow (empty: none)
+  };
+  void write(Job& job);
+
+  SequenceWriterOptions options_;
+  SequenceWriter writer_;      // used by the thread only, until close()
+  WriterThread<Job> thread_;   // declared after writer_: joined before it is destroyed
+  std::atomic<std::uint64_t> events_{0}, frames_{0}, depths_{0};
 };
 
 }  // namespace evio::simulator

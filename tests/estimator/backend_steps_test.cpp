@@ -3,6 +3,8 @@
 // msckf_updater.h), each on its own, against exact answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <unordered_set>
 #include <utility>
@@ -12,6 +14,7 @@
 #include "evio/estimator/backend/feature_selection.h"
 #include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/msckf_updater.h"
+#include "evio/estimator/backend/scene_depth.h"
 #include "evio/estimator/backend/slam_updater.h"
 #include "evio/estimator/backend/visual_models.h"
 
@@ -49,11 +52,12 @@ FilterState restingState(int clones, double p_var = 1e-2) {
 /// What an updater works on, owned by the test.
 struct UpdaterBench {
   explicit UpdaterBench(FilterState s) : state(std::move(s)), fej(state.imu) {}
-  UpdaterContext context() { return UpdaterContext{&state, &fej, &options, &stats}; }
+  UpdaterContext context() { return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated}; }
   FilterState state;
   ImuState fej;
   BackendOptions options;
   BackendStats stats;
+  TriangulatedPoints triangulated{30};
   Chi2Table chi2{0.95};
 };
 
@@ -282,6 +286,9 @@ TEST(BackendUpdaters, MsckfGivesTwoNMinusThreeRowsAndZeroResidualsForExactObserv
   EXPECT_EQ(msckf.lastCount(), 1);
   EXPECT_EQ(b.stats.msckf_features_used, 1);
   EXPECT_TRUE(tracks[4].observations.empty());
+  // The triangulated point is remembered for the depth prior from the map.
+  ASSERT_EQ(b.triangulated.points().size(), 1u);
+  EXPECT_LT((b.triangulated.points()[0] - p_W).norm(), 1e-9);
 }
 
 // With per-observation covariances R_i = σ_z² W_i⁻¹ W_i⁻ᵀ and P → 0, the
@@ -374,6 +381,83 @@ TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheDepthPrior) {
   EXPECT_NEAR(b.state.P(j + 2, j + 2), 0.5 * 0.5, 1e-15);
   EXPECT_EQ(b.stats.slam_initialized_prior, 1);
   EXPECT_TRUE(tracks.empty());
+}
+
+TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheMapDepthOnceTheFilterHasTriangulated) {
+  // Three triangulated points 2, 2.5 and 4 m in front of the clones (which
+  // look along +z of W): the lower median of 1/z is 1/2.5, so the feature
+  // enters with ρ0 = 0.4, σ = ρ0/2 (the fixed prior's shape), not the fixed 1 m prior.
+  UpdaterBench b(cloneRow({0.0, 0.0}));
+  b.options.slam_min_depth_m = 0.5;
+  for (const double z : {2.0, 2.5, 4.0}) b.triangulated.add(Vec3(0.3, -0.2, z));
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  TrackMap tracks{{3, track(3, {0, 1})}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_DOUBLE_EQ(b.state.features[0].abr.z(), 1.0 / 2.5);
+  const int j = b.state.featureIndex(0);
+  EXPECT_NEAR(b.state.P(j + 2, j + 2), 0.2 * 0.2, 1e-15);
+  EXPECT_EQ(b.stats.slam_initialized_map, 1);
+  EXPECT_EQ(b.stats.slam_initialized_prior, 0);
+
+  // Below map_prior_min_points, or with the map prior off: the fixed prior.
+  for (const bool from_map : {true, false}) {
+    UpdaterBench c(cloneRow({0.0, 0.0}));
+    c.options.slam_min_depth_m = 0.5;
+    c.options.depth_prior_from_map = from_map;
+    c.options.map_prior_min_points = from_map ? 4 : 3;
+    for (const double z : {2.0, 2.5, 4.0}) c.triangulated.add(Vec3(0.3, -0.2, z));
+    SlamUpdater fixed(c.context(), kCamera, 0.01, &c.chi2, &c.chi2, nullptr);
+    TrackMap t{{3, track(3, {0, 1})}};
+    ASSERT_TRUE(fixed.initialize({3}, &t));
+    EXPECT_DOUBLE_EQ(c.state.features[0].abr.z(), 1.0) << from_map;
+    EXPECT_EQ(c.stats.slam_initialized_prior, 1) << from_map;
+  }
+}
+
+TEST(SceneDepth, MedianInverseDepthIsOverThePointsInFrontOfTheClone) {
+  // A clone at (1, 2, 3) turned 90° about x of W: its optical axis (+z of C) is −y of W.
+  CameraClone clone;
+  clone.p_W_C = Vec3(1, 2, 3);
+  clone.q_W_C = Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()));
+  ASSERT_LT((clone.R_W_C() * Vec3::UnitZ() - Vec3(0, -1, 0)).norm(), 1e-15);
+  std::vector<Vec3> points;
+  for (const double depth : {1.0, 2.0, 4.0, 8.0}) points.push_back(clone.p_W_C + Vec3(0.1, -depth, 0.2));
+  points.push_back(clone.p_W_C + Vec3(0.0, 3.0, 0.0));  // behind: skipped
+  // 1/z = 1, 0.5, 0.25, 0.125: the lower median of four is the second smallest, 0.25.
+  const auto rho = medianInverseDepth(clone, points, 4);
+  ASSERT_TRUE(rho.has_value());
+  EXPECT_NEAR(*rho, 0.25, 1e-15);
+  EXPECT_FALSE(medianInverseDepth(clone, points, 5).has_value());
+  EXPECT_FALSE(medianInverseDepth(clone, {}, 1).has_value());
+}
+
+TEST(SceneDepth, TriangulatedPointsKeepTheLatestCapacityPoints) {
+  TriangulatedPoints memory(3);
+  for (int i = 0; i < 5; ++i) memory.add(Vec3(i, 0, 1));
+  memory.add(Vec3(std::nan(""), 0, 1));  // not finite: ignored
+  std::vector<double> x;
+  for (const Vec3& p : memory.points()) x.push_back(p.x());
+  std::sort(x.begin(), x.end());
+  EXPECT_EQ(x, (std::vector<double>{2, 3, 4}));
+}
+
+TEST(SceneDepth, ConvergedSlamPointsAreTheFeaturesWhoseDepthTheDataFixed) {
+  // Two features anchored in clone 1 (at x = 0.5), both at ρ = 0.5 (2 m):
+  // σ_ρ = 0.05 (10 % of ρ) counts, σ_ρ = 0.25 (50 %, a fresh depth prior) does not.
+  FilterState s = cloneRow({0.0, 0.5});
+  for (int k = 0; k < 2; ++k) {
+    SlamFeature f;
+    f.id = k;
+    f.anchor_clone_id = 1;
+    f.abr = Vec3(0.1, -0.2, 0.5);
+    Mat3 P_ff = 1e-6 * Mat3::Identity();
+    P_ff(2, 2) = k == 0 ? 0.05 * 0.05 : 0.25 * 0.25;
+    s.addFeature(f, P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, s.dim()));
+  }
+  const std::vector<Vec3> points = convergedSlamPoints(s, 0.25);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_LT((points[0] - Vec3(0.5 + 0.1 * 2.0, -0.2 * 2.0, 2.0)).norm(), 1e-12);
 }
 
 }  // namespace

@@ -284,6 +284,30 @@ TEST(BackendEkfUpdate, QrCompressionAndJosephFormGiveTheSameUpdate) {
   EXPECT_DOUBLE_EQ(mahalanobisSquared(MatX::Identity(1, n), VecX::Zero(1), s0.P, 1.0), 0.0);
 }
 
+// ekfUpdate's Joseph form is evaluated in O(n² m); it must equal the textbook
+// (I − KH) P (I − KH)ᵀ + σ² K Kᵀ with K = P Hᵀ (H P Hᵀ + σ² I)⁻¹, written out
+// with explicit n × n products, for a few rows (m ≪ n, the usual case).
+TEST(BackendEkfUpdate, JosephFormEqualsTheTextbookProduct) {
+  const FilterState s0 = stateWith(arcOfClones(4, 10), 10);
+  RandomStream rng(11, "H");
+  const int m = 5, n = s0.dim();
+  MatX H(m, n);
+  VecX r(m);
+  for (int i = 0; i < m; ++i) {
+    r(i) = 1e-3 * rng.normal();
+    for (int k = 0; k < n; ++k) H(i, k) = rng.normal();
+  }
+  const double sigma2 = 1e-4;
+  FilterState a = s0;
+  ASSERT_TRUE(ekfUpdate(a, H, r, sigma2, true));
+  const MatX S = H * s0.P * H.transpose() + sigma2 * MatX::Identity(m, m);
+  const MatX K = s0.P * H.transpose() * S.inverse();
+  const MatX IKH = MatX::Identity(n, n) - K * H;
+  const MatX expected = IKH * s0.P * IKH.transpose() + sigma2 * K * K.transpose();
+  EXPECT_LT((a.P - expected).norm(), 1e-10 * s0.P.norm());
+  EXPECT_LT((a.P - a.P.transpose()).norm(), 1e-18);
+}
+
 TEST(BackendSlamInit, DepthPriorAndTriangulatedInitialisation) {
   const auto clones = arcOfClones(8, 11, 1.0);
   FilterState s = stateWith(clones, 11);

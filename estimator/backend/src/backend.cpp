@@ -32,6 +32,7 @@ Backend::Backend(const BackendOptions& options, const BackendSensors& sensors)
       sigma_z_(normalizedImageSigma(options, sensors.camera)),
       slam_chi2_(options.slam_gate_probability),
       msckf_chi2_(options.msckf_gate_probability),
+      triangulated_(static_cast<std::size_t>(std::max(options.map_prior_memory, 0))),
       range_(updaterContext(), sensors.range_finder.value_or(RangeFinderSensor{}), &msckf_chi2_),
       zero_velocity_(updaterContext()),
       msckf_(updaterContext(), sensors.camera, sigma_z_ * sigma_z_, &msckf_chi2_),

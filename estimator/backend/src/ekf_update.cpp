@@ -53,9 +53,14 @@ bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, 
   const VecX dx = K * r;
   if (!dx.allFinite()) return false;
   if (joseph) {
-    MatX IKH = -K * H;
-    IKH.diagonal().array() += 1.0;
-    MatX Pn = IKH * P * IKH.transpose();
+    // Joseph form (I − KH) P (I − KH)ᵀ + σ² K Kᵀ without an n × n product:
+    // A = (I − KH) P = P − K (P Hᵀ)ᵀ, then A (I − KH)ᵀ = A − (A Hᵀ) Kᵀ;
+    // every product is (n × m)(m × n) or (n × n)(n × m): O(n² m), not O(n³).
+    MatX A = P;
+    A.noalias() -= K * PHt.transpose();
+    const MatX AHt = A * H.transpose();
+    MatX Pn = std::move(A);
+    Pn.noalias() -= AHt * K.transpose();
     Pn.noalias() += sigma2 * K * K.transpose();
     state.P.swap(Pn);
   } else {

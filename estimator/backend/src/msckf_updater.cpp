@@ -29,6 +29,7 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
       ++stats().msckf_features_rejected;
       continue;
     }
+    triangulatedPoints().add(res.p_W);
     used.push_back(std::move(res));
   }
   last_count_ = static_cast<int>(used.size());

@@ -86,7 +86,7 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
     if (it == tracks->end() || it->second.observations.empty()) continue;
     const FeatureTrack track = it->second;
     tracks->erase(it);
-    const DepthPrior prior = depthPrior(state().clones[c], track.observations.back().z);
+    const DepthPrior prior = depthPrior(c, track.observations.back().z);
     bool done = false;
     if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) return false;
     if (!done) initializeWithPrior(track, c, prior);
@@ -110,21 +110,37 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, double prior
                                  [this](MatX* H) { constrain(H); });
   if (outcome == SlamInitOutcome::kUpdateFailed) return false;
   *done = outcome == SlamInitOutcome::kOk;
-  if (*done) ++stats().slam_initialized_triangulated;
+  if (!*done) return true;
+  ++stats().slam_initialized_triangulated;
+  const CameraClone& anchor = clones.back();  // the triangulation's anchor: the track's last clone
+  triangulatedPoints().add(anchor.p_W_C + anchor.R_W_C() * Vec3(res.abr.x(), res.abr.y(), 1.0) / res.abr.z());
   return true;
 }
 
-SlamUpdater::DepthPrior SlamUpdater::depthPrior(const CameraClone& clone, const Vec2& z) const {
-  if (const auto rho = rangeDepthPrior(clone, z)) return {*rho, options().range_prior_relative_sigma * *rho, true};
-  // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min).
-  return {1.0 / (2.0 * options().slam_min_depth_m), fixedDepthPriorSigma(), false};
+SlamUpdater::DepthPrior SlamUpdater::depthPrior(std::size_t c, const Vec2& z) const {
+  if (const auto rho = rangeDepthPrior(state().clones[c], z))
+    return {*rho, options().range_prior_relative_sigma * *rho, DepthPrior::Source::kRange};
+  // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min), i.e. σ_ρ0 = ρ0 / 2.
+  const DepthPrior fixed{1.0 / (2.0 * options().slam_min_depth_m), fixedDepthPriorSigma(), DepthPrior::Source::kFixed};
+  if (!options().depth_prior_from_map) return fixed;
+  // The same shape centred on the median inverse depth of what the filter triangulated.
+  std::vector<Vec3> points = convergedSlamPoints(state(), options().map_prior_max_relative_sigma);
+  const std::vector<Vec3>& recent = triangulatedPoints().points();
+  points.insert(points.end(), recent.begin(), recent.end());
+  const auto rho = medianInverseDepth(state().clones[c], points, options().map_prior_min_points);
+  if (!rho) return fixed;
+  return {*rho, 0.5 * *rho, DepthPrior::Source::kMap};
 }
 
 void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior) {
   const Vec2& z = track.observations.back().z;
   const Mat2& W = track.observations.back().whiten;
   addSlamFeatureWithPrior(state(), track.id, c, z, prior.rho, prior.sigma, sigma_z_, W);
-  ++(prior.from_range ? stats().slam_initialized_range : stats().slam_initialized_prior);
+  switch (prior.source) {
+    case DepthPrior::Source::kRange: ++stats().slam_initialized_range; break;
+    case DepthPrior::Source::kMap: ++stats().slam_initialized_map; break;
+    case DepthPrior::Source::kFixed: ++stats().slam_initialized_prior; break;
+  }
 }
 
 std::optional<double> SlamUpdater::rangeDepthPrior(const CameraClone& clone, const Vec2& z) const {

@@ -134,7 +134,9 @@ class Backend {
   void checkHealth();
   void setStatus(BackendStatus::Code code, const std::string& cause);
   Estimate makeEstimate() const;
-  UpdaterContext updaterContext() { return UpdaterContext{&state_, &fej_imu_, &options_, &stats_, &innovation_}; }
+  UpdaterContext updaterContext() {
+    return UpdaterContext{&state_, &fej_imu_, &options_, &stats_, &innovation_, &triangulated_};
+  }
 
   BackendOptions options_;
   BackendSensors sensors_;
@@ -168,6 +170,7 @@ class Backend {
   TrackMap tracks_;
   std::vector<Estimate> estimates_;
   InnovationStats innovation_;  // of the visual update under way
+  TriangulatedPoints triangulated_;  // for the depth prior from the map
 
   // The updaters (updater.h), on state_, fej_imu_, options_ and stats_.
   RangeUpdater range_;

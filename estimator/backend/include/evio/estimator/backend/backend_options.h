@@ -61,6 +61,20 @@ struct BackendOptions {
   /// d_min: the depth prior is ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min)
   /// (reference ρ0 = 1.3, σ 0.65 ⇔ d_min = 0.3846 m).
   double slam_min_depth_m = 0.3846;
+  /// Depth prior from the map: a new feature that cannot be triangulated
+  /// takes ρ0 = the median inverse depth, seen from its clone, of the points
+  /// the filter has triangulated (the last map_prior_memory MSCKF features and
+  /// triangulated SLAM initialisations) and of the SLAM features whose depth the
+  /// data have fixed (σ_ρ ≤ map_prior_max_relative_sigma · ρ), with σ_ρ0 = ρ0/2
+  /// (the fixed prior's shape), once at least map_prior_min_points are in
+  /// front of the clone; before that, the fixed prior
+  /// (docs/algorithms.md#depth-prior-from-the-map). The fixed prior fits one
+  /// scene depth: a 2.5 m scene with a 1 m prior drove the ANEES into the
+  /// thousands (README "Keyframe window and triangulation").
+  bool depth_prior_from_map = true;
+  int map_prior_memory = 30;
+  double map_prior_max_relative_sigma = 0.25;
+  int map_prior_min_points = 3;
   int slam_min_track_length = 10;          ///< observations before a track may become SLAM
   double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
   int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature
@@ -173,6 +187,11 @@ struct BackendOptions {
     v("initial_sigma_bg_degps", initial_sigma_bg_degps, "initial gyro bias sigma, deg/s");
     v("initial_sigma_ba_mps2", initial_sigma_ba_mps2, "initial accel bias sigma, m/s^2");
     v("slam_min_depth_m", slam_min_depth_m, "d_min of the depth prior, m");
+    v("depth_prior_from_map", depth_prior_from_map, "depth prior from the median depth of the triangulated points");
+    v("map_prior_memory", map_prior_memory, "latest triangulated points the map's depth remembers");
+    v("map_prior_max_relative_sigma", map_prior_max_relative_sigma,
+      "a SLAM feature counts for the map's depth when its sigma_rho / rho is at most this");
+    v("map_prior_min_points", map_prior_min_points, "points in front of the camera the map's depth needs");
     v("slam_min_track_length", slam_min_track_length, "observations before SLAM");
     v("slam_gate_probability", slam_gate_probability, "SLAM Mahalanobis gate probability");
     v("slam_max_gate_failures", slam_max_gate_failures, "gate failures removing a SLAM feature");

@@ -52,13 +52,15 @@ class SlamUpdater : public Updater {
 
  private:
   /// The inverse-depth prior a new feature observed at z in clone c takes:
-  /// from the range finder when it gives one, else the fixed prior.
+  /// from the range finder when it gives one, else from the map
+  /// (depth_prior_from_map) when it knows the scene's depth, else the fixed prior.
   struct DepthPrior {
+    enum class Source { kFixed, kRange, kMap };
     double rho = 0.0;    ///< 1/m
     double sigma = 0.0;  ///< 1/m
-    bool from_range = false;
+    Source source = Source::kFixed;
   };
-  DepthPrior depthPrior(const CameraClone& clone, const Vec2& z) const;
+  DepthPrior depthPrior(std::size_t c, const Vec2& z) const;
   /// Triangulated initialisation when the track fixes ρ better than the
   /// prior it would otherwise take (prior_sigma_rho, 1/m).
   bool initializeTriangulated(const FeatureTrack& track, double prior_sigma_rho, bool* done);

@@ -13,6 +13,7 @@
 #include "evio/estimator/backend/backend_options.h"
 #include "evio/estimator/backend/backend_status.h"
 #include "evio/estimator/backend/filter_state.h"
+#include "evio/estimator/backend/scene_depth.h"
 #include "evio/estimator/backend/triangulation.h"
 #include "evio/estimator/measurements.h"
 
@@ -28,6 +29,9 @@ struct UpdaterContext {
   BackendStats* stats = nullptr;
   /// The innovations of the visual update under way (measurements.h).
   InnovationStats* innovation = nullptr;
+  /// The latest triangulated points (scene_depth.h): MSCKF and SLAM
+  /// triangulations add theirs, the depth prior from the map reads them.
+  TriangulatedPoints* triangulated = nullptr;
 };
 
 /// Residual rows of a stacked update.
@@ -75,6 +79,7 @@ class Updater {
   FilterState& state() const { return *ctx_.state; }
   const BackendOptions& options() const { return *ctx_.options; }
   BackendStats& stats() const { return *ctx_.stats; }
+  TriangulatedPoints& triangulatedPoints() const { return *ctx_.triangulated; }
 
  private:
   UpdaterContext ctx_;

@@ -5,6 +5,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/io/tum.h"
+#include "evio/core/so3.h"
 
 namespace evio::estimator {
 
@@ -62,7 +63,29 @@ std::optional<ImuState> GroundTruthInitializer::offer(TimeNs t_imu_ns) {
   if (gt.back().t_ns < *t_init_cam_ns_)
     throw Error(path_ + ": ends at " + secondsText(gt.back().t_ns) + ", before the initialisation time " +
                 secondsText(*t_init_cam_ns_));
-  return initialStateFromTrajectory(gt, *t_init_cam_ns_, T_B_C_, half_window_s_, offset_ns_);
+  const ImuState x = initialStateFromTrajectory(gt, *t_init_cam_ns_, T_B_C_, half_window_s_, offset_ns_);
+  if (!perturbation_) return x;
+  RandomStream rng(perturbation_seed_, "initial_state");
+  return perturbInitialState(x, *perturbation_, rng);
+}
+
+void GroundTruthInitializer::perturbWith(const InitialErrorSigmas& sigmas, std::uint64_t seed) {
+  perturbation_ = sigmas;
+  perturbation_seed_ = seed;
+}
+
+ImuState perturbInitialState(const ImuState& x, const InitialErrorSigmas& sigmas, RandomStream& rng) {
+  const auto draw = [&rng](double sigma) -> Vec3 {
+    const double a = rng.normal(), b = rng.normal(), c = rng.normal();  // sequenced: a, b, c
+    return Vec3(a, b, c) * sigma;
+  };
+  ImuState out = x;
+  out.p_W_B += draw(sigmas.p_m);
+  out.v_W += draw(sigmas.v_mps);
+  out.q_W_B = (x.q_W_B * so3::expQuat(draw(sigmas.theta_rad))).normalized();
+  out.b_g += draw(sigmas.bg_radps);
+  out.b_a += draw(sigmas.ba_mps2);
+  return out;
 }
 
 Trajectory readTrajectoryPrefix(const std::string& path, TimeNs t_until_ns) {

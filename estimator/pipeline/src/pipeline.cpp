@@ -1,6 +1,7 @@
 #include "evio/estimator/pipeline/pipeline.h"
 
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -21,6 +22,13 @@ namespace evio::estimator {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// The backend's initial covariance as standard deviations in SI units.
+InitialErrorSigmas initialErrorSigmas(const BackendOptions& b) {
+  constexpr double kDeg = M_PI / 180.0;
+  return {b.initial_sigma_p_m, b.initial_sigma_v_mps, b.initial_sigma_theta_deg * kDeg,
+          b.initial_sigma_bg_degps * kDeg, b.initial_sigma_ba_mps2};
+}
 
 /// Adds the wall time of its lifetime to a counter.
 class StageTimer {
@@ -244,6 +252,11 @@ void PipelineRun::setupStages() {
       throw Error(sequence_ + ": no groundtruth.txt for --init groundtruth; run with --init static");
     initializer.emplace(groundtruth, options_.init.start_offset_s, options_.init.velocity_half_window_s,
                         rig_.eventCamera().T_B_C, offset_ns_);
+    if (options_.init.perturb) {
+      initializer->perturbWith(initialErrorSigmas(options_.backend), options_.seed);
+      result_.notes.push_back("initial state: the ground truth plus an error drawn from the initial covariance "
+                              "(init.perturb, seed " + std::to_string(options_.seed) + ")");
+    }
   } else {
     result_.notes.push_back("static initialisation: position and yaw zero, the estimate needs alignment");
   }

@@ -55,12 +55,19 @@ struct InitOptions {
   double start_offset_s = 0.0;
   /// Half-width of the central difference giving the initial velocity, s.
   double velocity_half_window_s = 0.01;
+  /// With mode groundtruth: start from the truth plus an error drawn from the
+  /// backend's initial covariance (backend.initial_sigma_*, stream of the
+  /// run's seed), so that the initial error is a sample of the covariance the
+  /// filter states, as a NEES study needs. Off: the truth exactly (the paper's
+  /// protocol), an error of zero under a covariance that is not.
+  bool perturb = false;
 
   template <class V>
   void fields(V& v) {
     v("mode", mode, "static (from the IMU) or groundtruth (groundtruth.txt, only when asked for)");
     v("start_offset_s", start_offset_s, "initialise this long after the start of the data, s");
     v("velocity_half_window_s", velocity_half_window_s, "half-width of the velocity difference, s");
+    v("perturb", perturb, "groundtruth: add an error drawn from the backend's initial covariance");
   }
   void validate() const;
 };

@@ -12,11 +12,14 @@
 // Per pixel u this is pixelTerm of eklt_cost.cpp: the warped point in crop
 // coordinates x = R u + (t − origin), the Catmull-Rom weights of its
 // fractional part, the template gradient g and ∂g/∂x from the 4×4 taps,
-// a = −g·w and ∂a/∂p. Each group's lanes accumulate their own partial sums
+// a = −g·w and ∂a/∂p. The patch is one flat run of P² pixels, eight
+// consecutive pixels per group whatever the row length. Each group's lanes accumulate their own partial sums
 // (Σ a², Σ a m, Σ|a|, the ten products of D, Σ a ∂a/∂p, Σ m ∂a/∂p), added
 // lane by lane in double precision at the end.
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "eklt_sums.h"
 

@@ -19,9 +19,17 @@ bool cpuHasAvx2() {
   }();
   return has;
 }
+bool cpuHasAvx512f() {
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") != 0;
+  }();
+  return has;
+}
 #else
 bool cpuHasAvx() { return false; }
 bool cpuHasAvx2() { return false; }
+bool cpuHasAvx512f() { return false; }
 #endif
 
 }  // namespace evio

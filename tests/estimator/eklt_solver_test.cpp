@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 
 #include <opencv2/core.hpp>
@@ -145,8 +147,9 @@ TEST(EkltCost, AvxTemplateLookupMatchesTheSse2OneBitForBit) {
   EXPECT_EQ(compared, 2000);
 }
 
-// The single-precision sums (eight pixels per group) give the same bits
-// through the AVX and the baseline lanes, and agree with the double-precision
+// The single-precision sums (sixteen pixels per group) give the same bits
+// through the AVX-512, AVX and baseline lanes (on a CPU without AVX-512 the
+// first is the AVX path again; the test prints which ran), and agree with the double-precision
 // evaluation to single-precision accuracy: cost within 1e-5, JᵀJ and Jᵀr
 // within 1e-4 of their largest entry.
 TEST(EkltCost, SinglePrecisionSumsAreTheSameBitsOnEveryPathAndMatchDouble) {
@@ -157,15 +160,20 @@ TEST(EkltCost, SinglePrecisionSumsAreTheSameBitsOnEveryPathAndMatchDouble) {
   single.single_precision = true;
   const EkltBatch twice{&f.templ, m.data(), kP};
   for (const Vec4& p : {Vec4(0.1, 50.3, 39.6, 0.7), Vec4(-0.4, 49.2, 41.1, -2.5), Vec4(0.02, 52.7, 37.9, 2.9)}) {
-    EkltEvaluation avx, baseline, reference;
-    ASSERT_TRUE(detail::evaluateEkltPath(single, p, true, &avx));
-    ASSERT_TRUE(detail::evaluateEkltPath(single, p, false, &baseline));
+    std::printf("simd levels compared: %d, %d, %d\n", detail::ekltSimdLevel(2), detail::ekltSimdLevel(1),
+                detail::ekltSimdLevel(0));
+    EkltEvaluation avx512, avx, baseline, reference;
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 2, &avx512));
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 1, &avx));
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 0, &baseline));
     ASSERT_TRUE(evaluateEklt(twice, p, true, &reference));
-    EXPECT_EQ(avx.cost, baseline.cost);
-    EXPECT_EQ(avx.abs_sum, baseline.abs_sum);
-    for (int r = 0; r < 4; ++r) {
-      EXPECT_EQ(avx.jtr[r], baseline.jtr[r]);
-      for (int c = 0; c < 4; ++c) EXPECT_EQ(avx.jtj(r, c), baseline.jtj(r, c));
+    for (const EkltEvaluation* other : {&avx, &avx512}) {
+      EXPECT_EQ(other->cost, baseline.cost);
+      EXPECT_EQ(other->abs_sum, baseline.abs_sum);
+      for (int r = 0; r < 4; ++r) {
+        EXPECT_EQ(other->jtr[r], baseline.jtr[r]);
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(other->jtj(r, c), baseline.jtj(r, c));
+      }
     }
     EXPECT_NEAR(avx.cost, reference.cost, 1e-5);
     EXPECT_NEAR(avx.abs_sum, reference.abs_sum, 1e-5 * reference.abs_sum);

@@ -496,12 +496,24 @@ void sumPatch(const EkltBatch& batch, const WarpFrame& frame, bool with_jacobian
 
 namespace {
 
-bool evaluateWith(const EkltBatch& batch, const Vec4& p, bool with_jacobian, bool avx, EkltEvaluation* out) {
+/// The instruction set for the single-precision lanes: the highest the CPU
+/// has, at most `limit` (0 baseline, 1 AVX, 2 AVX-512F).
+detail::SimdLevel simdLevel(int limit) {
+  if (limit >= 2 && cpuHasAvx512f()) return detail::SimdLevel::kAvx512;
+  if (limit >= 1 && cpuHasAvx()) return detail::SimdLevel::kAvx;
+  return detail::SimdLevel::kBaseline;
+}
+
+/// `simd`: the single-precision lanes' instruction set; the double-precision
+/// paths take AVX whenever it is not the baseline.
+bool evaluateWith(const EkltBatch& batch, const Vec4& p, bool with_jacobian, detail::SimdLevel simd,
+                  EkltEvaluation* out) {
+  const bool avx = simd != detail::SimdLevel::kBaseline;
   const WarpFrame frame(p);
   const bool inside = warpInside(*batch.templ, frame, batch.patch_size);
   EkltSums s;
-  if (batch.single_precision && with_jacobian && inside && batch.patch_size >= 8)
-    detail::sumPatchSingle(batch, detail::EkltWarp{frame.c, frame.s, frame.t, frame.w, frame.w_perp}, avx, &s);
+  if (batch.single_precision && with_jacobian && inside && batch.patch_size >= 4)
+    detail::sumPatchSingle(batch, detail::EkltWarp{frame.c, frame.s, frame.t, frame.w, frame.w_perp}, simd, &s);
 #if defined(EVIO_EKLT_AVX)
   else if (avx && with_jacobian && batch.patch_size >= 4)
     sumPatchAvx(batch, frame, inside, &s);
@@ -530,13 +542,15 @@ bool evaluateWith(const EkltBatch& batch, const Vec4& p, bool with_jacobian, boo
 }  // namespace
 
 bool evaluateEklt(const EkltBatch& batch, const Vec4& p, bool with_jacobian, EkltEvaluation* out) {
-  return evaluateWith(batch, p, with_jacobian, cpuHasAvx(), out);
+  static const detail::SimdLevel best = simdLevel(2);
+  return evaluateWith(batch, p, with_jacobian, best, out);
 }
 
 namespace detail {
-bool evaluateEkltPath(const EkltBatch& batch, const Vec4& p, bool avx, EkltEvaluation* out) {
-  return evaluateWith(batch, p, true, avx && cpuHasAvx(), out);
+bool evaluateEkltPath(const EkltBatch& batch, const Vec4& p, int simd_limit, EkltEvaluation* out) {
+  return evaluateWith(batch, p, true, simdLevel(simd_limit), out);
 }
+int ekltSimdLevel(int simd_limit) { return static_cast<int>(simdLevel(simd_limit)); }
 }  // namespace detail
 
 bool ekltResiduals(const EkltBatch& batch, const Vec4& p, VecX* r, MatX* d_r_d_p) {

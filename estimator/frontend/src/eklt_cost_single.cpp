@@ -1,18 +1,19 @@
 // The EKLT cost's sums with the Jacobian in single precision, eight patch
 // pixels per group (eklt_sums.h sumPatchSingle).
 //
-// The arithmetic is written once with GCC vector types of eight floats and
-// compiled twice: for AVX (one 256-bit register per vector) and for the
-// x86-64 baseline (two SSE registers per vector). Either way every lane
+// The arithmetic is written once with GCC vector types of sixteen floats
+// and compiled three times: for AVX-512F (one 512-bit register per vector),
+// for AVX (two 256-bit registers) and for the x86-64 baseline (four SSE
+// registers). Either way every lane
 // sees the same IEEE single-precision operations in the same order (the
 // build forbids FMA contraction), so both paths give the same bits. Only the
 // gathering of the template taps, which moves floats without arithmetic,
-// differs: an 8×8 transpose with AVX, a plain copy otherwise.
+// differs: 8×8 transposes with AVX and AVX-512, a plain copy otherwise.
 //
 // Per pixel u this is pixelTerm of eklt_cost.cpp: the warped point in crop
 // coordinates x = R u + (t − origin), the Catmull-Rom weights of its
 // fractional part, the template gradient g and ∂g/∂x from the 4×4 taps,
-// a = −g·w and ∂a/∂p. The patch is one flat run of P² pixels, eight
+// a = −g·w and ∂a/∂p. The patch is one flat run of P² pixels, sixteen
 // consecutive pixels per group whatever the row length. Each group's lanes accumulate their own partial sums
 // (Σ a², Σ a m, Σ|a|, the ten products of D, Σ a ∂a/∂p, Σ m ∂a/∂p), added
 // lane by lane in double precision at the end.
@@ -47,18 +48,28 @@ namespace baseline_lanes {
 namespace avx_lanes {
 #include "eklt_cost_single_lanes.inc"
 }  // namespace avx_lanes
-#undef EVIO_LANES_AVX
 #pragma GCC pop_options
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+namespace avx512_lanes {
+#include "eklt_cost_single_lanes.inc"
+}  // namespace avx512_lanes
+#pragma GCC pop_options
+#undef EVIO_LANES_AVX
 #endif
 
-void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, bool avx, EkltSums* sums) {
+void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, SimdLevel level, EkltSums* sums) {
 #if defined(EVIO_EKLT_SINGLE_AVX)
-  if (avx) {
+  if (level == SimdLevel::kAvx512) {
+    avx512_lanes::sumPatchLanes(batch, warp, sums);
+    return;
+  }
+  if (level == SimdLevel::kAvx) {
     avx_lanes::sumPatchLanes(batch, warp, sums);
     return;
   }
 #endif
-  (void)avx;
+  (void)level;
   baseline_lanes::sumPatchLanes(batch, warp, sums);
 }
 

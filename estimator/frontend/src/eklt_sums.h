@@ -20,13 +20,17 @@ struct EkltWarp {
   Vec2 w, w_perp;
 };
 
-/// The sums with the Jacobian in single precision, eight pixels per lane
+/// The instruction set of the single-precision lanes (the caller checked
+/// the CPU has it).
+enum class SimdLevel { kBaseline, kAvx, kAvx512 };
+
+/// The sums with the Jacobian in single precision, sixteen pixels per lane
 /// group, lane-wise partial sums added in a fixed order at the end. Needs
-/// P ≥ 8 and every lookup's 4×4 taps inside the template crop. Every lane
-/// operation is one IEEE single-precision operation, without FMA, in the
-/// same order on the AVX and the SSE2 path: the same bits on any x86-64 CPU.
-/// `avx`: take the AVX path (the caller checked the CPU has it).
-void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, bool avx, EkltSums* sums);
+/// P ≥ 4 (P² ≥ 16) and every lookup's 4×4 taps inside the template crop.
+/// Every lane operation is one IEEE single-precision operation, without FMA,
+/// in the same order on the AVX-512, AVX and SSE2 paths: the same bits on
+/// any x86-64 CPU.
+void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, SimdLevel level, EkltSums* sums);
 
 
 }  // namespace evio::estimator::detail

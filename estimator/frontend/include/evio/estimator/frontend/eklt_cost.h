@@ -81,9 +81,12 @@ namespace detail {
 /// has it) or the SSE2 one. Both must give the same bits.
 bool ekltSampleHasAvx();
 void ekltSampleInside(const GradientTemplate& templ, const Vec2& W, Vec2* g, Mat2* dg, bool avx);
-/// For tests: evaluateEklt with the Jacobian through the AVX paths (`avx`
-/// and the CPU has it) or the baseline ones; both must give the same bits.
-bool evaluateEkltPath(const EkltBatch& batch, const Vec4& p, bool avx, EkltEvaluation* out);
+/// For tests: evaluateEklt with the Jacobian through the highest
+/// instruction set the CPU has up to `simd_limit` (0 the x86-64 baseline,
+/// 1 AVX, 2 AVX-512F for the single-precision lanes); every path must give
+/// the same bits. ekltSimdLevel: the level that limit gives on this CPU.
+bool evaluateEkltPath(const EkltBatch& batch, const Vec4& p, int simd_limit, EkltEvaluation* out);
+int ekltSimdLevel(int simd_limit);
 }  // namespace detail
 
 }  // namespace evio::estimator

@@ -149,36 +149,56 @@ TEST(EkltCost, AvxTemplateLookupMatchesTheSse2OneBitForBit) {
 
 // The single-precision sums (sixteen pixels per group) give the same bits
 // through the AVX-512, AVX and baseline lanes (on a CPU without AVX-512 the
-// first is the AVX path again; the test prints which ran), and agree with the double-precision
-// evaluation to single-precision accuracy: cost within 1e-5, JᵀJ and Jᵀr
-// within 1e-4 of their largest entry.
+// first is the AVX path again; the test prints which ran), and agree with
+// the double-precision evaluation to single-precision accuracy: cost within
+// 1e-5, JᵀJ and Jᵀr within 1e-4 of their largest entry. Patches of 19 × 19
+// (23 groups, the last overlapping) and 5 × 5 (two groups, 25 pixels), in
+// the order 19, 5, 19: the per-thread table of patch coordinates follows
+// the size, so the second 19 gives the first one's bits.
+void expectSinglePathsAgree(const EkltBatch& single, const EkltBatch& twice, const Vec4& p) {
+  EkltEvaluation avx512, avx, baseline, reference;
+  ASSERT_TRUE(detail::evaluateEkltPath(single, p, 2, &avx512));
+  ASSERT_TRUE(detail::evaluateEkltPath(single, p, 1, &avx));
+  ASSERT_TRUE(detail::evaluateEkltPath(single, p, 0, &baseline));
+  ASSERT_TRUE(evaluateEklt(twice, p, true, &reference));
+  for (const EkltEvaluation* other : {&avx, &avx512}) {
+    EXPECT_EQ(other->cost, baseline.cost);
+    EXPECT_EQ(other->abs_sum, baseline.abs_sum);
+    for (int r = 0; r < 4; ++r) {
+      EXPECT_EQ(other->jtr[r], baseline.jtr[r]);
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(other->jtj(r, c), baseline.jtj(r, c));
+    }
+  }
+  EXPECT_NEAR(avx.cost, reference.cost, 1e-5);
+  EXPECT_NEAR(avx.abs_sum, reference.abs_sum, 1e-5 * reference.abs_sum);
+  EXPECT_LT((avx.jtj - reference.jtj).cwiseAbs().maxCoeff(), 1e-4 * reference.jtj.cwiseAbs().maxCoeff());
+  EXPECT_LT((avx.jtr - reference.jtr).cwiseAbs().maxCoeff(), 1e-4 * reference.jtr.cwiseAbs().maxCoeff());
+}
+
 TEST(EkltCost, SinglePrecisionSumsAreTheSameBitsOnEveryPathAndMatchDouble) {
+  std::printf("simd levels compared: %d, %d, %d\n", detail::ekltSimdLevel(2), detail::ekltSimdLevel(1),
+              detail::ekltSimdLevel(0));
   Fixture f;
   const EventArray events = test::generateEvents(f.tex, f.motion, test::Roi{30, 20, 75, 60}, 0.0, 0.2, 1e-3, 0.02);
   const std::vector<float> m = eventBatch(events, 0.15, 0.2, f.x0);
+  constexpr int kSmall = 5;  // the centre 5 × 5 of the 19 × 19 batch
+  std::vector<float> m_small;
+  for (int i = 0; i < kSmall; ++i)
+    for (int j = 0; j < kSmall; ++j) m_small.push_back(m[(i + (kP - kSmall) / 2) * kP + j + (kP - kSmall) / 2]);
   EkltBatch single{&f.templ, m.data(), kP};
   single.single_precision = true;
   const EkltBatch twice{&f.templ, m.data(), kP};
+  EkltBatch single_small{&f.templ, m_small.data(), kSmall};
+  single_small.single_precision = true;
+  const EkltBatch twice_small{&f.templ, m_small.data(), kSmall};
   for (const Vec4& p : {Vec4(0.1, 50.3, 39.6, 0.7), Vec4(-0.4, 49.2, 41.1, -2.5), Vec4(0.02, 52.7, 37.9, 2.9)}) {
-    std::printf("simd levels compared: %d, %d, %d\n", detail::ekltSimdLevel(2), detail::ekltSimdLevel(1),
-                detail::ekltSimdLevel(0));
-    EkltEvaluation avx512, avx, baseline, reference;
-    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 2, &avx512));
-    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 1, &avx));
-    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 0, &baseline));
-    ASSERT_TRUE(evaluateEklt(twice, p, true, &reference));
-    for (const EkltEvaluation* other : {&avx, &avx512}) {
-      EXPECT_EQ(other->cost, baseline.cost);
-      EXPECT_EQ(other->abs_sum, baseline.abs_sum);
-      for (int r = 0; r < 4; ++r) {
-        EXPECT_EQ(other->jtr[r], baseline.jtr[r]);
-        for (int c = 0; c < 4; ++c) EXPECT_EQ(other->jtj(r, c), baseline.jtj(r, c));
-      }
-    }
-    EXPECT_NEAR(avx.cost, reference.cost, 1e-5);
-    EXPECT_NEAR(avx.abs_sum, reference.abs_sum, 1e-5 * reference.abs_sum);
-    EXPECT_LT((avx.jtj - reference.jtj).cwiseAbs().maxCoeff(), 1e-4 * reference.jtj.cwiseAbs().maxCoeff());
-    EXPECT_LT((avx.jtr - reference.jtr).cwiseAbs().maxCoeff(), 1e-4 * reference.jtr.cwiseAbs().maxCoeff());
+    EkltEvaluation first, again;
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 2, &first));
+    expectSinglePathsAgree(single, twice, p);
+    expectSinglePathsAgree(single_small, twice_small, p);
+    ASSERT_TRUE(detail::evaluateEkltPath(single, p, 2, &again));
+    EXPECT_EQ(first.cost, again.cost);
+    EXPECT_TRUE(first.jtj == again.jtj && first.jtr == again.jtr);
   }
 }
 

@@ -163,6 +163,20 @@ TEST(GroundTruthInit, PerturbationIsADrawOfTheInitialCovariance) {
     for (int l = 3; l < k; ++l)
       EXPECT_LT(std::abs(sum_outer(k, l) / kDraws) / (sigma(k) * sigma(l)), 0.03) << k << "," << l;
   }
+  // The draw is exactly the documented one: p, v, θ (right perturbation
+  // q · Exp(δθ)), b_g, b_a, three normals each, in that order.
+  {
+    RandomStream drawn(5, "initial_state"), replay(5, "initial_state");
+    const ImuState y = perturbInitialState(x, sigmas, drawn);
+    Eigen::Matrix<double, 15, 1> n;
+    for (int k = 0; k < 15; ++k) n(k) = replay.normal();
+    EXPECT_TRUE(y.p_W_B == x.p_W_B + Vec3(n(0), n(1), n(2)) * sigmas.p_m);
+    EXPECT_TRUE(y.v_W == x.v_W + Vec3(n(3), n(4), n(5)) * sigmas.v_mps);
+    EXPECT_TRUE(y.q_W_B.coeffs() ==
+                (x.q_W_B * so3::expQuat(Vec3(n(6), n(7), n(8)) * sigmas.theta_rad)).normalized().coeffs());
+    EXPECT_TRUE(y.b_g == x.b_g + Vec3(n(9), n(10), n(11)) * sigmas.bg_radps);
+    EXPECT_TRUE(y.b_a == x.b_a + Vec3(n(12), n(13), n(14)) * sigmas.ba_mps2);
+  }
   // The same seed gives the same state.
   RandomStream a(3, "initial_state"), b(3, "initial_state");
   const ImuState ya = perturbInitialState(x, sigmas, a), yb = perturbInitialState(x, sigmas, b);

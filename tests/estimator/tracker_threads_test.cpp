@@ -158,8 +158,8 @@ TEST(HasteThreads, TrackPointsAreTheSameBitsForAnyThreadCount) {
 
 // The single-thread output of this scene, pinned for both precisions of
 // the optimiser's sums. Double precision: the one-pixel cost evaluation and
-// the four-pixel AVX path give the same hash; single precision: the AVX and
-// the baseline lanes do (eklt_solver_test). Double precision last re-pinned
+// the four-pixel AVX path give the same hash; single precision: the
+// AVX-512, AVX and baseline lanes do (eklt_solver_test). Double precision last re-pinned
 // when the template crop grew by 4 px; single precision when its lanes took
 // the patch as one flat run of P² pixels, sixteen per group (README "Real
 // time (issue 22)"). A change that is meant to alter the numbers must

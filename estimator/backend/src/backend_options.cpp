@@ -27,7 +27,9 @@ void BackendOptions::validate() const {
   requireNonNegative("initial_sigma_bg_degps", initial_sigma_bg_degps);
   requireNonNegative("initial_sigma_ba_mps2", initial_sigma_ba_mps2);
   requirePositive("slam_min_depth_m", slam_min_depth_m);
-  requirePositive("map_prior_max_relative_sigma", map_prior_max_relative_sigma);
+  // A fresh depth-prior feature has σ_ρ/ρ = 1/2: at 1/2 or above it would count as converged at once.
+  requireField(map_prior_max_relative_sigma > 0.0 && map_prior_max_relative_sigma < 0.5,
+               "map_prior_max_relative_sigma", "must be in (0, 0.5)");
   requireField(map_prior_memory >= 1 && map_prior_memory <= 100000, "map_prior_memory", "must be in [1, 100000]");
   requireField(map_prior_min_points >= 1, "map_prior_min_points", "must be >= 1");
   requireField(slam_min_track_length >= 1, "slam_min_track_length", "must be >= 1");

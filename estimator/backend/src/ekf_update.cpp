@@ -53,7 +53,7 @@ bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, 
   const VecX dx = K * r;
   if (!dx.allFinite()) return false;
   if (joseph) {
-    // Joseph form (I − KH) P (I − KH)ᵀ + σ² K Kᵀ without an n × n product:
+    // Joseph form (I − KH) P (I − KH)ᵀ + σ² K Kᵀ without an n × n by n × n product:
     // A = (I − KH) P = P − K (P Hᵀ)ᵀ, then A (I − KH)ᵀ = A − (A Hᵀ) Kᵀ;
     // every product is (n × m)(m × n) or (n × n)(n × m): O(n² m), not O(n³).
     MatX A = P;

@@ -1,4 +1,4 @@
-// The EKLT cost's sums with the Jacobian in single precision, eight patch
+// The EKLT cost's sums with the Jacobian in single precision, sixteen patch
 // pixels per group (eklt_sums.h sumPatchSingle).
 //
 // The arithmetic is written once with GCC vector types of sixteen floats
@@ -6,7 +6,7 @@
 // for AVX (two 256-bit registers) and for the x86-64 baseline (four SSE
 // registers). Either way every lane
 // sees the same IEEE single-precision operations in the same order (the
-// build forbids FMA contraction), so both paths give the same bits. Only the
+// build forbids FMA contraction), so all three paths give the same bits. Only the
 // gathering of the template taps, which moves floats without arithmetic,
 // differs: 8×8 transposes with AVX and AVX-512, a plain copy otherwise.
 //
@@ -31,7 +31,7 @@
 
 #define EVIO_LANES inline __attribute__((always_inline))
 
-// Vector types of 32 bytes without AVX change the calling convention of
+// Vector types of 64 bytes without AVX-512 change the calling convention of
 // functions taking them by value; every such function here is inlined.
 #pragma GCC diagnostic ignored "-Wpsabi"
 

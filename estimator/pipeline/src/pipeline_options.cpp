@@ -14,6 +14,7 @@ void InitOptions::validate() const {
                    (mode == "auto" ? "; auto is gone: ground truth is used only when asked for" : "") + ")");
   requireNonNegative("start_offset_s", start_offset_s);
   requirePositive("velocity_half_window_s", velocity_half_window_s);
+  requireField(!perturb || mode == "groundtruth", "perturb", "needs mode groundtruth (it perturbs the ground-truth start)");
 }
 
 void CalibrationOptions::validate() const {

@@ -10,6 +10,7 @@
 
 #include "evio/core/camera/camera.h"
 #include "evio/core/eigen_types.h"
+#include "evio/core/error.h"
 #include "evio/estimator/backend/backend_options.h"
 #include "evio/estimator/backend/backend_status.h"
 #include "evio/estimator/backend/filter_state.h"
@@ -79,7 +80,10 @@ class Updater {
   FilterState& state() const { return *ctx_.state; }
   const BackendOptions& options() const { return *ctx_.options; }
   BackendStats& stats() const { return *ctx_.stats; }
-  TriangulatedPoints& triangulatedPoints() const { return *ctx_.triangulated; }
+  TriangulatedPoints& triangulatedPoints() const {
+    require(ctx_.triangulated != nullptr, "Updater: the context has no triangulated-point memory");
+    return *ctx_.triangulated;
+  }
 
  private:
   UpdaterContext ctx_;

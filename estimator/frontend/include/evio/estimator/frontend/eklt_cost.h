@@ -29,7 +29,7 @@ struct EkltBatch {
   const GradientTemplate* templ = nullptr;  ///< gradient of the initialisation frame
   const float* measured = nullptr;          ///< P×P row-major, unit L2 norm
   int patch_size = 0;                       ///< P (odd)
-  /// Evaluate the sums with the Jacobian in single precision, eight patch
+  /// Evaluate the sums with the Jacobian in single precision, sixteen patch
   /// pixels at a time, where the warp's lookups lie inside the template
   /// (eklt_cost_single.cpp); the same bits on every x86-64 CPU. Else, and
   /// without the Jacobian, double precision.

@@ -39,7 +39,7 @@ struct EkltOptions {
   // Optimisation.
   std::string solver = "lm";           ///< "lm" (hand-written, hot path) or "ceres" (reference)
   int max_iterations = 25;             ///< per batch
-  /// The optimiser's sums over the patch in single precision, eight pixels
+  /// The optimiser's sums over the patch in single precision, sixteen pixels
   /// at a time (eklt_cost.h EkltBatch::single_precision), else in double
   /// precision four at a time; the same bits on every x86-64 CPU either way.
   bool single_precision = true;
@@ -112,7 +112,7 @@ struct EkltOptions {
     v("batch_max_events", batch_max_events, "largest batch");
     v("solver", solver, "lm or ceres");
     v("max_iterations", max_iterations, "optimiser iterations per batch");
-    v("single_precision", single_precision, "optimiser sums in single precision, eight pixels at a time");
+    v("single_precision", single_precision, "optimiser sums in single precision, sixteen pixels at a time");
     v("function_tolerance", function_tolerance, "relative cost change that stops the optimiser");
     v("parameter_tolerance", parameter_tolerance, "relative step that stops the optimiser");
     v("min_tracking_quality", min_tracking_quality, "lost below this tracking quality");

@@ -11,6 +11,7 @@
 #include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/triangulation.h"
+#include "evio/estimator/backend/updater.h"
 #include "evio/estimator/backend/visual_models.h"
 
 namespace evio::estimator {
@@ -253,17 +254,22 @@ TEST(BackendReanchoring, PreservesWorldPointAndItsCovariance) {
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(s.P).eigenvalues().minCoeff(), 0.0);
 }
 
+/// m random residual rows over n states: H ~ N(0, 1), r ~ N(0, 1e-6).
+UpdateRows randomRows(int m, int n, std::uint64_t seed) {
+  RandomStream rng(seed, "H");
+  UpdateRows rows{MatX(m, n), VecX(m)};
+  for (int i = 0; i < m; ++i) {
+    rows.r(i) = 1e-3 * rng.normal();
+    for (int k = 0; k < n; ++k) rows.H(i, k) = rng.normal();
+  }
+  return rows;
+}
+
 TEST(BackendEkfUpdate, QrCompressionAndJosephFormGiveTheSameUpdate) {
   const auto clones = arcOfClones(4, 10);
   const FilterState s0 = stateWith(clones, 10);
-  RandomStream rng(10, "H");
-  const int m = 60, n = s0.dim();
-  MatX H(m, n);
-  VecX r(m);
-  for (int i = 0; i < m; ++i) {
-    r(i) = 1e-3 * rng.normal();
-    for (int k = 0; k < n; ++k) H(i, k) = rng.normal();
-  }
+  const int n = s0.dim();
+  const auto [H, r] = randomRows(60, n, 10);
   const double sigma2 = 1e-4;
   FilterState a = s0, b = s0, c = s0;
   ASSERT_TRUE(ekfUpdate(a, H, r, sigma2, true));
@@ -289,14 +295,8 @@ TEST(BackendEkfUpdate, QrCompressionAndJosephFormGiveTheSameUpdate) {
 // with explicit n × n products, for a few rows (m ≪ n, the usual case).
 TEST(BackendEkfUpdate, JosephFormEqualsTheTextbookProduct) {
   const FilterState s0 = stateWith(arcOfClones(4, 10), 10);
-  RandomStream rng(11, "H");
   const int m = 5, n = s0.dim();
-  MatX H(m, n);
-  VecX r(m);
-  for (int i = 0; i < m; ++i) {
-    r(i) = 1e-3 * rng.normal();
-    for (int k = 0; k < n; ++k) H(i, k) = rng.normal();
-  }
+  const auto [H, r] = randomRows(m, n, 11);
   const double sigma2 = 1e-4;
   FilterState a = s0;
   ASSERT_TRUE(ekfUpdate(a, H, r, sigma2, true));

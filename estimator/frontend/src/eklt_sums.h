@@ -32,5 +32,13 @@ enum class SimdLevel { kBaseline, kAvx, kAvx512 };
 /// any x86-64 CPU.
 void sumPatchSingle(const EkltBatch& batch, const EkltWarp& warp, SimdLevel level, EkltSums* sums);
 
+#if defined(__GNUC__) && defined(__x86_64__)
+/// The sums with the Jacobian in double precision, four pixels per AVX
+/// register (eklt_cost_double_avx.cpp), the same bits as the one-pixel loop
+/// of eklt_cost.cpp. `inside`: every lookup's taps inside the crop (else the
+/// template's clamped lookup). Needs P ≥ 4 and a CPU with AVX.
+void sumPatchDoubleAvx(const EkltBatch& batch, const EkltWarp& warp, bool inside, EkltSums* sums);
+#endif
+
 
 }  // namespace evio::estimator::detail

@@ -89,7 +89,7 @@ std::vector<std::string> SequenceWriter::close() {
 
 AsyncSequenceWriter::AsyncSequenceWriter(const std::string& folder, const SequenceWriterOptions& options,
                                          std::size_t queue_slots)
-    : options_(options), writer_(folder, options), thread_(queue_slots, [this](Job& job) { write(job); }) {}
+    : options_(options), writer_(folder, options), thread_(queue_slots, [this](Job& job) { write(job); }, SlotRingThread<Job>::OnDestroy::kDropQueued) {}
 
 void AsyncSequenceWriter::write(Job& job) {
   switch (job.kind) {

@@ -1,15 +1,15 @@
-// The writer thread (writer_thread.h) and the sequence writer on it
+// The slot ring thread with the writers' policy (core/slot_ring_thread.h,
+// queued jobs dropped on destruction) and the sequence writer on it
 // (AsyncSequenceWriter): jobs consumed in push order in at most `capacity`
 // reused slots, the consumer's first error rethrown on the producer's thread
 // (at a later push or at finish) without a hang, queued jobs dropped on
 // destruction; the asynchronous writer's files are byte for byte those of
 // SequenceWriter, and a failed write completes no file.
-#include "evio/simulator/writer_thread.h"
-
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <future>
 #include <set>
 #include <stdexcept>
@@ -20,6 +20,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
+#include "evio/core/slot_ring_thread.h"
 #include "evio/simulator/sequence_writer.h"
 #include "temp_dir.h"
 
@@ -27,6 +28,13 @@ namespace evio::simulator {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// The ring with the writers' policy: queued jobs dropped on destruction.
+template <class Slot>
+struct WriterThread : SlotRingThread<Slot> {
+  WriterThread(std::size_t capacity, std::function<void(Slot&)> consume)
+      : SlotRingThread<Slot>(capacity, std::move(consume), SlotRingThread<Slot>::OnDestroy::kDropQueued) {}
+};
 
 /// A slot with a buffer that keeps its capacity from use to use.
 struct Numbers {

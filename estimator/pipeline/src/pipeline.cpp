@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "evio/core/error.h"
+#include "evio/core/slot_ring_thread.h"
 #include "evio/core/stopwatch.h"
 #include "evio/core/io/config.h"
 #include "evio/core/io/images_txt.h"
@@ -15,7 +16,6 @@
 #include "evio/estimator/pipeline/method.h"
 #include "evio/estimator/pipeline/sequence_rig.h"
 #include "evio/estimator/pipeline/stages.h"
-#include "handoff_queue.h"
 
 namespace evio::estimator {
 
@@ -359,8 +359,11 @@ void PipelineRun::loop() {
   loop_start_cpu_s_ = Stopwatch::processCpuSeconds();
   cpu_clock_ = options_.output.timing_clock == "cpu";
   // With a backend thread, items wait in a ring of 64 between the two sides.
-  std::optional<HandoffQueue<BackendWork>> handoff;
-  if (options_.backend_thread) handoff.emplace(64, [this](BackendWork& w) { consume(w); });
+  // Destroyed while an error unwinds, it still consumes what was queued: the
+  // backend takes every item read before the error, as on one thread.
+  std::optional<SlotRingThread<BackendWork>> handoff;
+  if (options_.backend_thread)
+    handoff.emplace(64, [this](BackendWork& w) { consume(w); }, SlotRingThread<BackendWork>::OnDestroy::kConsumeQueued);
   SequenceItem item;
   while (!stopped_.load() && !(handoff && handoff->failed())) {
     {

@@ -29,7 +29,7 @@
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/images_txt.h"
 #include "evio/simulator/event_camera.h"
-#include "evio/simulator/writer_thread.h"
+#include "evio/core/slot_ring_thread.h"
 
 namespace evio::simulator {
 
@@ -74,7 +74,7 @@ class SequenceWriter {
   std::uint64_t events_ = 0, frames_ = 0, depths_ = 0;
 };
 
-/// A SequenceWriter on a thread of its own (writer_thread.h): the same calls
+/// A SequenceWriter on a thread of its own (core/slot_ring_thread.h): the same calls
 /// write the same files, but an append only copies its data into one of
 /// `queue_slots` reusable slots (waiting while all are queued) and returns,
 /// so the files are written while the caller renders. The arguments are
@@ -110,7 +110,7 @@ class AsyncSequenceWriter {
 
   SequenceWriterOptions options_;
   SequenceWriter writer_;      // used by the thread only, until close()
-  WriterThread<Job> thread_;   // declared after writer_: joined before it is destroyed
+  SlotRingThread<Job> thread_;  // declared after writer_: joined before it is destroyed; drops queued jobs
   std::atomic<std::uint64_t> events_{0}, frames_{0}, depths_{0};
 };
 

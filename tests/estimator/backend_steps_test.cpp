@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <unordered_set>
 #include <utility>
 
@@ -188,6 +189,40 @@ TEST(BackendUpdaters, ConstrainRemovesTheYawDirectionExactlyOnce) {
   MatX H2 = MatX::Ones(3, b.state.dim());
   updater.constrain(&H2);
   EXPECT_TRUE(H2.isApprox(MatX::Ones(3, b.state.dim())));
+}
+
+TEST(BackendUpdaters, ConstrainKeepsRowsBlindToGlobalTranslation) {
+  // Rows blind to a global translation t (every position state moved by the
+  // same a: H t = 0) must stay blind after the yaw direction is projected out,
+  // or the constraint itself adds translation (and through it yaw) information.
+  FilterState state = restingState(3);
+  state.imu.p_W_B = Vec3(1, 2, 3);
+  state.imu.v_W = Vec3(0.5, -0.2, 0.1);
+  state.clones[0].p_fej = Vec3(0.3, 0.1, 0.0);
+  state.clones[1].p_fej = Vec3(-0.4, 1.1, 0.2);
+  state.clones[2].p_fej = Vec3(2.0, -0.7, 1.5);
+  UpdaterBench b(state);
+  b.options.observability_constraint = true;
+  ZeroVelocityUpdater updater(b.context());
+  const auto translation = [&b](int axis) {
+    VecX t = VecX::Zero(b.state.dim());
+    t(kIdxP + axis) = 1.0;
+    for (std::size_t i = 0; i < b.state.clones.size(); ++i) t(b.state.cloneIndex(i) + kCloneP + axis) = 1.0;
+    return t;
+  };
+  // Random rows, made blind to the three translations by projection.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  MatX H(4, b.state.dim());
+  for (Eigen::Index i = 0; i < H.size(); ++i) H.data()[i] = normal(rng);
+  MatX T(b.state.dim(), 3);
+  for (int a = 0; a < 3; ++a) T.col(a) = translation(a);
+  H -= H * T * (T.transpose() * T).inverse() * T.transpose();
+  updater.constrain(&H);
+  const VecX n = b.state.yawDirection(b.fej);
+  EXPECT_LT((H * n).norm(), 1e-12 * H.norm() * n.norm());
+  for (int a = 0; a < 3; ++a) EXPECT_LT((H * translation(a)).norm(), 1e-12 * H.norm()) << "axis " << a;
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(n.dot(translation(a)), 0.0, 1e-12) << "axis " << a;
 }
 
 TEST(BackendUpdaters, ZeroVelocityUpdateIsTheScalarKalmanGainPerAxis) {

@@ -17,6 +17,7 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
   augmentClone();
   const std::size_t c = state_.clones.size() - 1;
   const std::int64_t clone_id = state_.clones[c].id;
+  if (c > 0) slam_.diffuseBearings(nsToSeconds(state_.clones[c].t_ns - state_.clones[c - 1].t_ns));
 
   const std::vector<FeatureObservation> observations = undistortObservations(set, sensors_.camera, sigma_z_, &stats_);
   slam_.marginalizeUnobserved(observations);

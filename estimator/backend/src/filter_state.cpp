@@ -95,14 +95,21 @@ void FilterState::removeFeature(std::size_t j) {
 }
 
 VecX FilterState::yawDirection(const ImuState& x) const {
+  // The rotation is about the vertical through the centroid c of the position
+  // states (IMU and clones, first estimates), so that n is orthogonal to every
+  // global translation t (Σ_k e_z × (p_k − c) = 0): projecting n out of a row
+  // that is blind to translation (H t = 0) then keeps it blind.
   const Vec3 e_z = Vec3::UnitZ();
+  Vec3 c = x.p_W_B;
+  for (const CameraClone& clone : clones) c += clone.p_fej;
+  c /= static_cast<double>(clones.size() + 1);
   VecX n = VecX::Zero(dim());
-  n.segment<3>(kIdxP) = e_z.cross(x.p_W_B);
+  n.segment<3>(kIdxP) = e_z.cross(x.p_W_B - c);
   n.segment<3>(kIdxV) = e_z.cross(x.v_W);
   n.segment<3>(kIdxTheta) = x.q_W_B.conjugate() * e_z;
   for (std::size_t i = 0; i < clones.size(); ++i) {
     const int k = cloneIndex(i);
-    n.segment<3>(k + kCloneP) = e_z.cross(clones[i].p_fej);
+    n.segment<3>(k + kCloneP) = e_z.cross(clones[i].p_fej - c);
     n.segment<3>(k + kCloneTheta) = clones[i].q_fej.conjugate() * e_z;
   }
   return n;

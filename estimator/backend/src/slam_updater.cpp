@@ -14,6 +14,19 @@ void SlamUpdater::removeFeature(std::size_t j) {
   ++stats().slam_features_removed;
 }
 
+void SlamUpdater::diffuseBearings(double dt_s) {
+  const double q = options().slam_bearing_walk_px2_per_s;
+  if (!(q > 0.0) || !(dt_s > 0.0)) return;
+  const Vec4 k = camera_.intrinsics();  // fx fy cx cy: α = x/f_x, β = y/f_y in normalised units
+  const double var_alpha = q * dt_s / (k(0) * k(0));
+  const double var_beta = q * dt_s / (k(1) * k(1));
+  for (std::size_t j = 0; j < state().features.size(); ++j) {
+    const int i = state().featureIndex(j);
+    state().P(i, i) += var_alpha;
+    state().P(i + 1, i + 1) += var_beta;
+  }
+}
+
 void SlamUpdater::marginalizeUnobserved(const std::vector<FeatureObservation>& observations) {
   std::unordered_set<FeatureId> observed;
   for (const FeatureObservation& o : observations) observed.insert(o.id);

@@ -86,6 +86,13 @@ struct BackendOptions {
   /// Off: on the backend's consistency scenario it lowers the NEES only from
   /// 8.86 to 8.47 at the true noise (docs/algorithms.md#second-order-depth-term).
   bool slam_second_order_noise = false;
+  /// Track drift, px²/s: a tracker's error against the truth wanders like a
+  /// random walk of this rate (measured by `evio evaluate-tracks`), which a
+  /// SLAM feature's bearing (α, β) takes up as process noise between two
+  /// measurement sets, P_αα += q Δt / f_x², P_ββ += q Δt / f_y²
+  /// (docs/algorithms.md#track-drift). 0: a feature's bearing is fixed and
+  /// every observation's error independent of the others.
+  double slam_bearing_walk_px2_per_s = 0.0;
 
   // MSCKF features ----------------------------------------------------------------
   /// Also use tracks lost before spanning the window (xVIO drops them).
@@ -198,6 +205,8 @@ struct BackendOptions {
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
     v("slam_second_order_noise", slam_second_order_noise,
       "SLAM observation noise includes the second-order inverse-depth term");
+    v("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s,
+      "track drift: random-walk rate of a SLAM feature's bearing, px^2/s");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
     v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");
     v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for an MSCKF triangulation, px");

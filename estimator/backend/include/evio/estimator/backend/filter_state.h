@@ -100,12 +100,18 @@ class FilterState {
   /// P ← (P + Pᵀ)/2.
   void symmetrize();
 
-  /// The unobservable global-yaw direction n of the error state (a rotation by
-  /// ε about e_z of W moves every pose): IMU part at `imu` (δp = e_z × p,
-  /// δv = e_z × v, δθ = R_W_Bᵀ e_z), clone parts at their first estimates
-  /// (δp_C = e_z × p_C, δθ_C = R_W_Cᵀ e_z), zero for the anchored features and
-  /// the biases. Global translation needs no such care: every model of the
-  /// backend is exactly invariant to it at any linearisation point.
+  /// The unobservable global-yaw direction n of the error state: a rotation
+  /// by ε about the vertical e_z through the centroid c of the position
+  /// states (IMU and clones) moves every pose; IMU part at `imu`
+  /// (δp = e_z × (p − c), δv = e_z × v, δθ = R_W_Bᵀ e_z), clone parts at
+  /// their first estimates (δp_C = e_z × (p_C − c), δθ_C = R_W_Cᵀ e_z), zero
+  /// for the anchored features and the biases. Global translation t is
+  /// unobservable too, and every model of the backend is exactly invariant to
+  /// it (H t = 0 at any linearisation point); rotating about the centroid makes
+  /// n orthogonal to t, so the constraint H ← H − (H n) nᵀ/|n|² keeps H t = 0.
+  /// (About the origin instead, nᵀt ≠ 0 and the projection itself gave the
+  /// rows translation information, ‖H t‖ up to 3 % of ‖H‖, which the filter
+  /// turned into spurious yaw information.)
   VecX yawDirection(const ImuState& imu) const;
 
   /// The error-state difference x ⊟ ref (the inverse of correct(): ref with

@@ -34,6 +34,10 @@ class SlamUpdater : public Updater {
         range_(range) {}
   const char* name() const override { return "slam"; }
 
+  /// Track drift (BackendOptions::slam_bearing_walk_px2_per_s): the bearing
+  /// (α, β) of every SLAM feature gains q Δt / f² of variance, dt_s the time
+  /// since the previous measurement set.
+  void diffuseBearings(double dt_s);
   /// Marginalises the SLAM features that the observations do not contain (lost tracks).
   void marginalizeUnobserved(const std::vector<FeatureObservation>& observations);
   /// The observations of SLAM features in clone c (position), each gated with

@@ -280,6 +280,33 @@ TEST(BackendUpdaters, SlamPruneDropsGatedOutAndNonFiniteFeatures) {
   EXPECT_EQ(b.stats.slam_features_removed, 3);
 }
 
+TEST(BackendUpdaters, TrackDriftWidensEveryBearingByTheWalkOverTheInterval) {
+  // P_αα += q Δt / f_x², P_ββ += q Δt / f_y², nothing else: q = 2 px²/s over
+  // 0.05 s at f_x = 100 px, f_y = 80 px.
+  const Camera camera(PinholeCamera(200, 100, Vec4(100, 80, 100, 50)));
+  FilterState state = restingState(1);
+  for (FeatureId id = 0; id < 2; ++id) {
+    SlamFeature f;
+    f.id = id;
+    f.abr = Vec3(0.1, -0.2, 0.5);
+    state.features.push_back(f);
+  }
+  state.P = MatX::Identity(state.dim(), state.dim()) * 1e-4;
+  state.P(state.featureIndex(0), state.featureIndex(1)) = state.P(state.featureIndex(1), state.featureIndex(0)) = 3e-5;
+  UpdaterBench b(state);
+  SlamUpdater slam(b.context(), camera, 0.01, &b.chi2, &b.chi2, nullptr);
+  slam.diffuseBearings(0.05);  // the option is off: nothing changes
+  EXPECT_EQ(b.state.P, state.P);
+  b.options.slam_bearing_walk_px2_per_s = 2.0;
+  slam.diffuseBearings(0.05);
+  MatX expected = state.P;
+  for (std::size_t j = 0; j < 2; ++j) {
+    expected(state.featureIndex(j), state.featureIndex(j)) += 2.0 * 0.05 / (100.0 * 100.0);
+    expected(state.featureIndex(j) + 1, state.featureIndex(j) + 1) += 2.0 * 0.05 / (80.0 * 80.0);
+  }
+  EXPECT_EQ((b.state.P - expected).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(BackendUpdaters, MsckfUsesEveryChosenTrackOnceAndCountsWhyNot) {
   // Two clones with no baseline: no parallax for any track; each chosen track is emptied.
   UpdaterBench b(restingState(2));

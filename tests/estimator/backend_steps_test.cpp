@@ -53,12 +53,15 @@ FilterState restingState(int clones, double p_var = 1e-2) {
 /// What an updater works on, owned by the test.
 struct UpdaterBench {
   explicit UpdaterBench(FilterState s) : state(std::move(s)), fej(state.imu) {}
-  UpdaterContext context() { return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated}; }
+  UpdaterContext context() {
+    return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated, &initialized_at};
+  }
   FilterState state;
   ImuState fej;
   BackendOptions options;
   BackendStats stats;
   TriangulatedPoints triangulated{30};
+  TimeNs initialized_at = 0;
   Chi2Table chi2{0.95};
 };
 
@@ -442,6 +445,40 @@ TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheDepthPrior) {
   const int j = b.state.featureIndex(0);
   EXPECT_NEAR(b.state.P(j + 2, j + 2), 0.5 * 0.5, 1e-15);
   EXPECT_EQ(b.stats.slam_initialized_prior, 1);
+  EXPECT_TRUE(tracks.empty());
+}
+
+TEST(BackendUpdaters, BeforeTheFixedPriorsWaitATrackStaysAnMsckfTrackUntilTheMapKnowsTheDepth) {
+  // slam_fixed_prior_wait_s = 2 s: at 1.5 s after initialisation, with no
+  // parallax and no map depth, the track is left where it was and counted;
+  // once the map has three points it enters with the map's prior; without
+  // the map, at 2 s it takes the fixed prior.
+  UpdaterBench b(cloneRow({0.0, 0.0}));
+  b.options.slam_min_depth_m = 0.5;
+  b.options.slam_fixed_prior_wait_s = 2.0;
+  b.initialized_at = secondsToNs(10.0);
+  b.state.imu.t_ns = secondsToNs(11.5);
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  TrackMap tracks{{3, track(3, {0, 1})}, {4, track(4, {0, 1})}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  EXPECT_TRUE(b.state.features.empty());
+  ASSERT_EQ(tracks.count(3), 1u);
+  EXPECT_EQ(tracks[3].observations.size(), 2u);
+  EXPECT_EQ(b.stats.slam_waiting_for_depth, 1);
+  EXPECT_EQ(b.stats.slam_initialized_prior, 0);
+
+  b.state.imu.t_ns = secondsToNs(12.0);  // the wait is over: the fixed prior
+  ASSERT_TRUE(slam.initialize({4}, &tracks));
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_DOUBLE_EQ(b.state.features[0].abr.z(), 1.0);
+  EXPECT_EQ(b.stats.slam_initialized_prior, 1);
+
+  b.state.imu.t_ns = secondsToNs(11.0);  // (a clock back in the wait) the map's depth needs no wait
+  for (const double z : {2.0, 2.5, 4.0}) b.triangulated.add(Vec3(0.3, -0.2, z));
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  ASSERT_EQ(b.state.features.size(), 2u);
+  EXPECT_DOUBLE_EQ(b.state.features[1].abr.z(), 1.0 / 2.5);
+  EXPECT_EQ(b.stats.slam_initialized_map, 1);
   EXPECT_TRUE(tracks.empty());
 }
 

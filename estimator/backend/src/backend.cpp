@@ -70,6 +70,7 @@ void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 
   initialized_ = true;
   tracks_.clear();
   triangulated_ = TriangulatedPoints(static_cast<std::size_t>(std::max(options_.map_prior_memory, 0)));
+  initialized_at_ = state_.imu.t_ns;
   // The IMU reading at the initial time: interpolated between buffered
   // readings, else held from the nearest one.
   while (imu_buffer_.size() >= 2 && imu_buffer_[1].t_ns <= state.t_ns) imu_buffer_.pop_front();

@@ -36,6 +36,7 @@ void BackendOptions::validate() const {
   requireField(slam_gate_probability > 0.0 && slam_gate_probability < 1.0, "slam_gate_probability",
                "must be in (0, 1)");
   requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");
+  requireInRange("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s, 0.0, 1e9);
   requireInRange("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s, 0.0, 1e6);
   requireField(msckf_min_track_length >= 2, "msckf_min_track_length", "must be >= 2");
   requireNonNegative("min_parallax_px", min_parallax_px);

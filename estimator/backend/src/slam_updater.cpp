@@ -102,7 +102,13 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
     const DepthPrior prior = depthPrior(c, track.observations.back().z);
     bool done = false;
     if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) return false;
-    if (!done) initializeWithPrior(track, c, prior);
+    if (done) continue;
+    if (prior.source == DepthPrior::Source::kFixed && !fixedPriorAllowed()) {
+      tracks->emplace(track.id, track);  // stays an MSCKF track until the scene's depth is known
+      ++stats().slam_waiting_for_depth;
+      continue;
+    }
+    initializeWithPrior(track, c, prior);
   }
   return true;
 }
@@ -128,6 +134,11 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, double prior
   const CameraClone& anchor = clones.back();  // the triangulation's anchor: the track's last clone
   triangulatedPoints().add(anchor.p_W_C + anchor.R_W_C() * Vec3(res.abr.x(), res.abr.y(), 1.0) / res.abr.z());
   return true;
+}
+
+bool SlamUpdater::fixedPriorAllowed() const {
+  const double wait_s = options().slam_fixed_prior_wait_s;
+  return wait_s <= 0.0 || nsToSeconds(state().imu.t_ns - initializedAt()) >= wait_s;
 }
 
 SlamUpdater::DepthPrior SlamUpdater::depthPrior(std::size_t c, const Vec2& z) const {

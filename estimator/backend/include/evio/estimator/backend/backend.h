@@ -135,7 +135,7 @@ class Backend {
   void setStatus(BackendStatus::Code code, const std::string& cause);
   Estimate makeEstimate() const;
   UpdaterContext updaterContext() {
-    return UpdaterContext{&state_, &fej_imu_, &options_, &stats_, &innovation_, &triangulated_};
+    return UpdaterContext{&state_, &fej_imu_, &options_, &stats_, &innovation_, &triangulated_, &initialized_at_};
   }
 
   BackendOptions options_;
@@ -171,6 +171,7 @@ class Backend {
   std::vector<Estimate> estimates_;
   InnovationStats innovation_;  // of the visual update under way
   TriangulatedPoints triangulated_;  // for the depth prior from the map
+  TimeNs initialized_at_ = 0;        // filter time of initialize()
 
   // The updaters (updater.h), on state_, fej_imu_, options_ and stats_.
   RangeUpdater range_;

@@ -93,6 +93,12 @@ struct BackendOptions {
   /// (docs/algorithms.md#track-drift). 0: a feature's bearing is fixed and
   /// every observation's error independent of the others.
   double slam_bearing_walk_px2_per_s = 0.0;
+  /// How long after the filter's initialisation a SLAM candidate may take the
+  /// fixed depth prior (ρ0 = 1/(2 d_min)) when neither a triangulation, the
+  /// range finder nor the map gives its depth, s. Before that the track stays
+  /// an MSCKF track, waiting for the map to know the scene's depth
+  /// (docs/algorithms.md "Depth prior from the map"). 0: at once.
+  double slam_fixed_prior_wait_s = 0.0;
 
   // MSCKF features ----------------------------------------------------------------
   /// Also use tracks lost before spanning the window (xVIO drops them).
@@ -205,6 +211,8 @@ struct BackendOptions {
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
     v("slam_second_order_noise", slam_second_order_noise,
       "SLAM observation noise includes the second-order inverse-depth term");
+    v("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s,
+      "time after initialisation before a SLAM candidate may take the fixed depth prior, s");
     v("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s,
       "track drift: random-walk rate of a SLAM feature's bearing, px^2/s");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");

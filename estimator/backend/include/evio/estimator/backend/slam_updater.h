@@ -69,6 +69,9 @@ class SlamUpdater : public Updater {
   /// prior it would otherwise take (prior_sigma_rho, 1/m).
   bool initializeTriangulated(const FeatureTrack& track, double prior_sigma_rho, bool* done);
   void initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior);
+  /// The fixed prior may be taken: slam_fixed_prior_wait_s has passed since
+  /// the filter's initialisation.
+  bool fixedPriorAllowed() const;
   /// ρ0 of a feature seen at normalised z from `clone`, from the latest range
   /// reading (BackendOptions::range_prior_relative_sigma); nullopt when there
   /// is none or the ray does not meet the level plane in front of the camera.

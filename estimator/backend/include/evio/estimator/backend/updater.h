@@ -33,6 +33,8 @@ struct UpdaterContext {
   /// The latest triangulated points (scene_depth.h): MSCKF and SLAM
   /// triangulations add theirs, the depth prior from the map reads them.
   TriangulatedPoints* triangulated = nullptr;
+  /// The filter time of the backend's initialisation.
+  const TimeNs* initialized_at = nullptr;
 };
 
 /// Residual rows of a stacked update.
@@ -78,6 +80,10 @@ class Updater {
   double minParallaxNormalized(const Camera& camera, double parallax_px) const;
 
   FilterState& state() const { return *ctx_.state; }
+  TimeNs initializedAt() const {
+    require(ctx_.initialized_at != nullptr, "Updater: no initialisation time in the context");
+    return *ctx_.initialized_at;
+  }
   const BackendOptions& options() const { return *ctx_.options; }
   BackendStats& stats() const { return *ctx_.stats; }
   TriangulatedPoints& triangulatedPoints() const {

@@ -448,7 +448,7 @@ TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheDepthPrior) {
   EXPECT_TRUE(tracks.empty());
 }
 
-TEST(BackendUpdaters, BeforeTheFixedPriorsWaitATrackStaysAnMsckfTrackUntilTheMapKnowsTheDepth) {
+TEST(BackendUpdaters, BeforeTheFixedPriorsWaitATrackStaysInTheWindowUntilTheMapKnowsTheDepth) {
   // slam_fixed_prior_wait_s = 2 s: at 1.5 s after initialisation, with no
   // parallax and no map depth, the track is left where it was and counted;
   // once the map has three points it enters with the map's prior; without

@@ -104,7 +104,7 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
     if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) return false;
     if (done) continue;
     if (prior.source == DepthPrior::Source::kFixed && !fixedPriorAllowed()) {
-      tracks->emplace(track.id, track);  // stays an MSCKF track until the scene's depth is known
+      tracks->emplace(track.id, track);  // stays in the window until the scene's depth is known
       ++stats().slam_waiting_for_depth;
       continue;
     }

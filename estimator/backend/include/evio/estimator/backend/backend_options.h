@@ -96,7 +96,7 @@ struct BackendOptions {
   /// How long after the filter's initialisation a SLAM candidate may take the
   /// fixed depth prior (ρ0 = 1/(2 d_min)) when neither a triangulation, the
   /// range finder nor the map gives its depth, s. Before that the track stays
-  /// an MSCKF track, waiting for the map to know the scene's depth
+  /// in the window, waiting for the map to know the scene's depth
   /// (docs/algorithms.md "Depth prior from the map"). 0: at once.
   double slam_fixed_prior_wait_s = 0.0;
 

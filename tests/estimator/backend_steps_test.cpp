@@ -226,6 +226,13 @@ TEST(BackendUpdaters, ConstrainKeepsRowsBlindToGlobalTranslation) {
   EXPECT_LT((H * n).norm(), 1e-12 * H.norm() * n.norm());
   for (int a = 0; a < 3; ++a) EXPECT_LT((H * translation(a)).norm(), 1e-12 * H.norm()) << "axis " << a;
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(n.dot(translation(a)), 0.0, 1e-12) << "axis " << a;
+  // The rotation is about the vertical through the centroid of the four
+  // positions (1, 2, 3), (0.3, 0.1, 0), (−0.4, 1.1, 0.2), (2, −0.7, 1.5):
+  // c = (0.725, 0.625, 1.175), so δp = e_z × (p − c).
+  const Vec3 c(0.725, 0.625, 1.175);
+  EXPECT_TRUE(n.segment<3>(kIdxP).isApprox(Vec3::UnitZ().cross(Vec3(1, 2, 3) - c), 1e-12));
+  EXPECT_TRUE(n.segment<3>(b.state.cloneIndex(2) + kCloneP)
+                  .isApprox(Vec3::UnitZ().cross(Vec3(2.0, -0.7, 1.5) - c), 1e-12));
 }
 
 TEST(BackendUpdaters, ZeroVelocityUpdateIsTheScalarKalmanGainPerAxis) {

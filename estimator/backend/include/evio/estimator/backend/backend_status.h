@@ -43,7 +43,7 @@ struct BackendStats {
   std::int64_t slam_initialized_prior = 0;
   std::int64_t slam_initialized_range = 0;  ///< depth prior from the range finder
   std::int64_t slam_initialized_map = 0;    ///< depth prior from the map's median depth
-  std::int64_t slam_waiting_for_depth = 0;  ///< candidates left in the window (slam_fixed_prior_wait_s)
+  std::int64_t slam_waiting_for_depth = 0;  ///< waits of SLAM candidates for a depth, per set (slam_fixed_prior_wait_s)
   std::int64_t slam_updates_rejected = 0;  ///< Mahalanobis gate
   std::int64_t slam_features_removed = 0;  ///< lost, gated out or invalid
   std::int64_t slam_reanchored = 0;
@@ -69,7 +69,7 @@ struct BackendStats {
     v("slam_initialized_prior", slam_initialized_prior, "slam initialized prior");
     v("slam_initialized_range", slam_initialized_range, "SLAM features initialised with a range-finder depth prior");
     v("slam_initialized_map", slam_initialized_map, "SLAM features initialised with the map's depth prior");
-    v("slam_waiting_for_depth", slam_waiting_for_depth, "SLAM candidates left in the window until the depth is known");
+    v("slam_waiting_for_depth", slam_waiting_for_depth, "SLAM candidates left waiting for a depth, counted once per measurement set");
     v("slam_updates_rejected", slam_updates_rejected, "SLAM observations rejected by the Mahalanobis gate");
     v("slam_features_removed", slam_features_removed, "SLAM features removed: lost, gated out or invalid");
     v("slam_reanchored", slam_reanchored, "slam reanchored");

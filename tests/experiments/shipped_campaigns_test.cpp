@@ -37,11 +37,11 @@ std::string optionValue(const std::vector<std::string>& command, const std::stri
   return it != command.end() && it + 1 != command.end() ? *(it + 1) : std::string();
 }
 
-/// What `evio estimate [--config <config>] [--method <name>] --set …` does
-/// with the settings (estimate_command.cpp): --method wins, else the
-/// settings' `method`; then every key is filled and checked.
+/// What `evio estimate [--config <config>] [--method <name>] [--init <mode>] --set …`
+/// does with the settings (estimate_command.cpp): --method wins, else the
+/// settings' `method`; --init sets init.mode; then every key is filled and checked.
 void checkEstimatorSettings(const std::string& config_file, const Overrides& estimate_set,
-                            const std::string& command_method) {
+                            const std::string& command_method, const std::string& command_init) {
   config::Document doc = config_file.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(config_file);
   for (const auto& o : asArguments(estimate_set)) config::applyOverride(doc, o);
   std::string m = command_method;
@@ -51,6 +51,7 @@ void checkEstimatorSettings(const std::string& config_file, const Overrides& est
     m = config::scalarAs<std::string>(doc, node, "method");
   }
   config::applyOverride(doc, "method=" + m);
+  if (!command_init.empty()) config::applyOverride(doc, "init.mode=" + command_init);
   estimator::PipelineOptions options = estimator::PipelineOptions::forMethod(m);
   config::fill(doc, "", options);
 }
@@ -82,9 +83,11 @@ TEST(ShippedCampaigns, EveryJobHasAValidScenarioAndEstimatorSettings) {
       std::string config = optionValue(command, "--config");
       if (!config.empty() && fs::path(config).is_relative()) config = (root / config).string();  // run from the repository
       const std::string command_method = optionValue(command, "--method");
-      if (settings_seen.insert(config + "|" + command_method + "|" + overridesText(job.estimate_set)).second) {
+      const std::string command_init = optionValue(command, "--init");
+      if (settings_seen.insert(config + "|" + command_method + "|" + command_init + "|" + overridesText(job.estimate_set))
+              .second) {
         try {
-          checkEstimatorSettings(config, job.estimate_set, command_method);
+          checkEstimatorSettings(config, job.estimate_set, command_method, command_init);
         } catch (const std::exception& e) {
           ADD_FAILURE() << job.id << ": " << e.what();
         }

@@ -97,18 +97,21 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
     if (static_cast<int>(state().features.size()) >= options().max_slam_features) break;
     auto it = tracks->find(id);
     if (it == tracks->end() || it->second.observations.empty()) continue;
-    const FeatureTrack track = it->second;
-    tracks->erase(it);
+    const FeatureTrack& track = it->second;  // initialising touches the state, not the tracks
     const DepthPrior prior = depthPrior(c, track.observations.back().z);
     bool done = false;
-    if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) return false;
-    if (done) continue;
-    if (prior.source == DepthPrior::Source::kFixed && !fixedPriorAllowed()) {
-      tracks->emplace(track.id, track);  // stays in the window until the scene's depth is known
-      ++stats().slam_waiting_for_depth;
-      continue;
+    if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) {
+      tracks->erase(it);
+      return false;
     }
-    initializeWithPrior(track, c, prior);
+    if (!done) {
+      if (prior.source == DepthPrior::Source::kFixed && !fixedPriorAllowed()) {
+        ++stats().slam_waiting_for_depth;  // stays in the window until the scene's depth is known
+        continue;
+      }
+      initializeWithPrior(track, c, prior);
+    }
+    tracks->erase(it);  // the track is a SLAM feature now, or failed its gate
   }
   return true;
 }

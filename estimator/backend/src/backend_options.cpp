@@ -37,6 +37,10 @@ void BackendOptions::validate() const {
                "must be in (0, 1)");
   requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");
   requireInRange("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s, 0.0, 1e9);
+  requireField(slam_scene_depth_share >= 0.0 && slam_scene_depth_share < 1.0, "slam_scene_depth_share",
+               "must be in [0, 1)");
+  requireField(slam_scene_depth_memory_s > 0.0 && slam_scene_depth_memory_s <= 1e9, "slam_scene_depth_memory_s",
+               "must be in (0, 1e9]");
   requireInRange("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s, 0.0, 1e6);
   requireField(msckf_min_track_length >= 2, "msckf_min_track_length", "must be >= 2");
   requireNonNegative("min_parallax_px", min_parallax_px);

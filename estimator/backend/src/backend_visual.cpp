@@ -17,7 +17,11 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
   augmentClone();
   const std::size_t c = state_.clones.size() - 1;
   const std::int64_t clone_id = state_.clones[c].id;
-  if (c > 0) slam_.diffuseBearings(nsToSeconds(state_.clones[c].t_ns - state_.clones[c - 1].t_ns));
+  if (c > 0) {
+    const double dt_s = nsToSeconds(state_.clones[c].t_ns - state_.clones[c - 1].t_ns);
+    slam_.diffuseBearings(dt_s);
+    slam_.diffuseSceneDepth(dt_s);
+  }
 
   const std::vector<FeatureObservation> observations = undistortObservations(set, sensors_.camera, sigma_z_, &stats_);
   slam_.marginalizeUnobserved(observations);

@@ -1,5 +1,7 @@
 #include "evio/estimator/backend/filter_state.h"
 
+#include <cmath>
+
 #include "evio/core/error.h"
 #include "evio/core/so3.h"
 
@@ -30,6 +32,7 @@ void FilterState::correct(const VecX& dx) {
     clones[i].q_W_C = (clones[i].q_W_C * so3::expQuat(dx.segment<3>(k + kCloneTheta))).normalized();
   }
   for (std::size_t j = 0; j < features.size(); ++j) features[j].abr += dx.segment<3>(featureIndex(j));
+  if (has_scene_depth) scene_rho += dx(sceneDepthIndex());
 }
 
 namespace {
@@ -84,7 +87,7 @@ void FilterState::removeClone(std::size_t i) {
 void FilterState::addFeature(const SlamFeature& f, const Mat3& P_ff,
                              const Eigen::Matrix<double, 3, Eigen::Dynamic>& P_fx) {
   require(P_fx.cols() == dim(), "FilterState::addFeature: cross-covariance has the wrong size");
-  insertRowsCols(P, dim(), P_fx, P_ff);
+  insertRowsCols(P, featureIndex(features.size()), P_fx, P_ff);  // after the last feature, before ρ_s
   features.push_back(f);
 }
 
@@ -92,6 +95,15 @@ void FilterState::removeFeature(std::size_t j) {
   require(j < features.size(), "FilterState::removeFeature: no such feature");
   removeRowsCols(P, featureIndex(j), kFeatureDim);
   features.erase(features.begin() + static_cast<std::ptrdiff_t>(j));
+}
+
+void FilterState::addSceneDepth(double rho, double variance) {
+  require(!has_scene_depth, "FilterState::addSceneDepth: the state has a scene depth already");
+  require(std::isfinite(rho) && variance > 0.0 && std::isfinite(variance),
+          "FilterState::addSceneDepth: the scene depth needs a finite mean and a positive variance");
+  insertRowsCols(P, dim(), MatX::Zero(1, dim()), MatX::Constant(1, 1, variance));
+  has_scene_depth = true;
+  scene_rho = rho;
 }
 
 VecX FilterState::yawDirection(const ImuState& x) const {
@@ -116,7 +128,8 @@ VecX FilterState::yawDirection(const ImuState& x) const {
 }
 
 VecX FilterState::minus(const FilterState& ref) const {
-  require(clones.size() == ref.clones.size() && features.size() == ref.features.size(),
+  require(clones.size() == ref.clones.size() && features.size() == ref.features.size() &&
+              has_scene_depth == ref.has_scene_depth,
           "FilterState::minus: states of different layouts");
   VecX d(dim());
   d.segment<3>(kIdxP) = imu.p_W_B - ref.imu.p_W_B;
@@ -130,6 +143,7 @@ VecX FilterState::minus(const FilterState& ref) const {
     d.segment<3>(k + kCloneTheta) = so3::log(Quat(ref.clones[i].q_W_C.conjugate() * clones[i].q_W_C));
   }
   for (std::size_t j = 0; j < features.size(); ++j) d.segment<3>(featureIndex(j)) = features[j].abr - ref.features[j].abr;
+  if (has_scene_depth) d(sceneDepthIndex()) = scene_rho - ref.scene_rho;
   return d;
 }
 

@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 
 #include "evio/core/camera/camera_common.h"
+#include "evio/core/error.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/visual_models.h"
@@ -74,6 +75,24 @@ void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, co
   P_ff.topLeftCorner<2, 2>() = sigma_z * sigma_z * W_inv * W_inv.transpose();
   P_ff(2, 2) = sigma_rho0 * sigma_rho0;
   state.addFeature(f, P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim()));
+}
+
+void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t c, const Vec2& z,
+                                  double sigma_delta, double sigma_z, const Mat2& whiten) {
+  require(state.has_scene_depth, "addSlamFeatureFromSceneDepth: the state has no scene depth");
+  SlamFeature f;
+  f.id = id;
+  f.anchor_clone_id = state.clones[c].id;
+  f.abr = Vec3(z.x(), z.y(), state.scene_rho);
+  const int s = state.sceneDepthIndex();
+  const Mat2 W_inv = whiten.inverse();
+  Mat3 P_ff = Mat3::Zero();
+  P_ff.topLeftCorner<2, 2>() = sigma_z * sigma_z * W_inv * W_inv.transpose();
+  P_ff(2, 2) = state.P(s, s) + sigma_delta * sigma_delta;
+  // δρ = δρ_s + δ: cov(δρ, δx) = cov(δρ_s, δx) for every other entry x.
+  Eigen::Matrix<double, 3, Eigen::Dynamic> P_fx = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim());
+  P_fx.row(2) = state.P.row(s);
+  state.addFeature(f, P_ff, P_fx);
 }
 
 bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, const Vec3& abr, double sigma2,

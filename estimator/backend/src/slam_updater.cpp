@@ -1,6 +1,7 @@
 #include "evio/estimator/backend/slam_updater.h"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_set>
 
 #include "evio/estimator/backend/msckf_update.h"
@@ -25,6 +26,13 @@ void SlamUpdater::diffuseBearings(double dt_s) {
     state().P(i, i) += var_alpha;
     state().P(i + 1, i + 1) += var_beta;
   }
+}
+
+void SlamUpdater::diffuseSceneDepth(double dt_s) {
+  if (!state().has_scene_depth || !(dt_s > 0.0)) return;
+  const double sigma0 = fixedDepthPriorSigma();
+  const int s = state().sceneDepthIndex();
+  state().P(s, s) += options().slam_scene_depth_share * sigma0 * sigma0 * dt_s / options().slam_scene_depth_memory_s;
 }
 
 void SlamUpdater::marginalizeUnobserved(const std::vector<FeatureObservation>& observations) {
@@ -162,12 +170,28 @@ SlamUpdater::DepthPrior SlamUpdater::depthPrior(std::size_t c, const Vec2& z) co
 void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior) {
   const Vec2& z = track.observations.back().z;
   const Mat2& W = track.observations.back().whiten;
+  if (prior.source == DepthPrior::Source::kFixed && initializeFromSceneDepth(track, c, prior)) {
+    ++stats().slam_initialized_prior;
+    return;
+  }
   addSlamFeatureWithPrior(state(), track.id, c, z, prior.rho, prior.sigma, sigma_z_, W);
   switch (prior.source) {
     case DepthPrior::Source::kRange: ++stats().slam_initialized_range; break;
     case DepthPrior::Source::kMap: ++stats().slam_initialized_map; break;
     case DepthPrior::Source::kFixed: ++stats().slam_initialized_prior; break;
   }
+}
+
+bool SlamUpdater::initializeFromSceneDepth(const FeatureTrack& track, std::size_t c, const DepthPrior& fixed) {
+  const double share = options().slam_scene_depth_share;
+  if (!(share > 0.0)) return false;
+  // The fixed prior's variance split: c σ² shared (ρ_s), (1 − c) σ² the feature's own.
+  if (!state().has_scene_depth) state().addSceneDepth(fixed.rho, share * fixed.sigma * fixed.sigma);
+  if (!(state().scene_rho > 0.0)) return false;  // a scene behind the camera: the plain prior
+  const TrackObservation& last = track.observations.back();
+  addSlamFeatureFromSceneDepth(state(), track.id, c, last.z, std::sqrt(1.0 - share) * fixed.sigma, sigma_z_,
+                               last.whiten);
+  return true;
 }
 
 std::optional<double> SlamUpdater::rangeDepthPrior(const CameraClone& clone, const Vec2& z) const {

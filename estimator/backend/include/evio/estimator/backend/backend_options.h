@@ -99,6 +99,19 @@ struct BackendOptions {
   /// in the window, waiting for the map to know the scene's depth
   /// (docs/algorithms.md "Depth prior from the map"). 0: at once.
   double slam_fixed_prior_wait_s = 0.0;
+  /// The scene's inverse depth ρ_s as a state (docs/algorithms.md "Scene
+  /// depth"): every feature that takes the fixed prior shares the prior's
+  /// error (the scene stands at one depth, ρ0 says another), which
+  /// independent priors read as scale. With share c in (0, 1), ρ_s enters
+  /// the state at the first fixed-prior feature as ρ0 with variance c σ_ρ0²,
+  /// and each fixed-prior feature takes ρ = ρ_s + δ with var δ = (1 − c) σ_ρ0²
+  /// and δ independent: the first has the fixed prior's marginal exactly,
+  /// later ones start from what the filter has learnt of ρ_s. 0: off
+  /// (independent fixed priors).
+  double slam_scene_depth_share = 0.0;
+  /// ρ_s random-walks (the scene changes as the camera moves): its variance
+  /// grows by c σ_ρ0² over this time, s.
+  double slam_scene_depth_memory_s = 10.0;
 
   // MSCKF features ----------------------------------------------------------------
   /// Also use tracks lost before spanning the window (xVIO drops them).
@@ -213,6 +226,10 @@ struct BackendOptions {
       "SLAM observation noise includes the second-order inverse-depth term");
     v("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s,
       "time after initialisation before a SLAM candidate may take the fixed depth prior, s");
+    v("slam_scene_depth_share", slam_scene_depth_share,
+      "share of the fixed depth prior's variance in the scene inverse depth state (0: off)");
+    v("slam_scene_depth_memory_s", slam_scene_depth_memory_s,
+      "time over which the scene inverse depth's variance grows by its prior share, s");
     v("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s,
       "track drift: random-walk rate of a SLAM feature's bearing, px^2/s");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");

@@ -7,9 +7,11 @@
 ///
 /// Error-state layout (the order of P's rows and columns):
 ///
-///   [ δp_W_B(3) δv_W(3) δθ_B(3) δb_g(3) δb_a(3) | clone 0 (δp_W_C, δθ_C) ... clone M-1 | f_0 (δα δβ δρ) ... f_N-1 ]
+///   [ δp_W_B(3) δv_W(3) δθ_B(3) δb_g(3) δb_a(3) | clone 0 (δp_W_C, δθ_C) ... clone M-1 | f_0 (δα δβ δρ) ... f_N-1 | δρ_s ]
 ///
-/// with clones oldest first and features in insertion order.
+/// with clones oldest first and features in insertion order; δρ_s, the
+/// scene's inverse depth (1/m), only once it has been added
+/// (BackendOptions::slam_scene_depth_share, docs/algorithms.md "Scene depth").
 ///
 /// Error-state convention (used by every Jacobian of the backend):
 ///   positions, velocity, biases, feature parameters:  x = x̂ + δx
@@ -67,11 +69,18 @@ class FilterState {
   ImuState imu;
   std::vector<CameraClone> clones;   ///< oldest first
   std::vector<SlamFeature> features;
+  /// The scene's inverse depth ρ_s, 1/m: the part of the fixed depth prior's
+  /// error that every feature initialised from it shares (ρ_i = ρ_s + δ_i).
+  /// The last error-state entry while has_scene_depth.
+  bool has_scene_depth = false;
+  double scene_rho = 0.0;
   MatX P;                            ///< error-state covariance (dim × dim), symmetric PD
 
-  /// Total error-state dimension 15 + 6 M + 3 N.
+  /// Total error-state dimension 15 + 6 M + 3 N (+ 1 with the scene depth).
   int dim() const { return kImuDim + kCloneDim * static_cast<int>(clones.size()) +
-                           kFeatureDim * static_cast<int>(features.size()); }
+                           kFeatureDim * static_cast<int>(features.size()) + (has_scene_depth ? 1 : 0); }
+  /// Covariance index of ρ_s (requires has_scene_depth).
+  int sceneDepthIndex() const { return featureIndex(features.size()); }
   /// First covariance index of clone i (position in `clones`).
   int cloneIndex(std::size_t i) const { return kImuDim + kCloneDim * static_cast<int>(i); }
   /// First covariance index of feature j (position in `features`).
@@ -96,6 +105,8 @@ class FilterState {
   void addFeature(const SlamFeature& f, const Mat3& P_ff, const Eigen::Matrix<double, 3, Eigen::Dynamic>& P_fx);
   /// Removes feature j and its rows/columns (marginalisation).
   void removeFeature(std::size_t j);
+  /// Adds ρ_s = rho with variance `variance`, uncorrelated with the rest.
+  void addSceneDepth(double rho, double variance);
 
   /// P ← (P + Pᵀ)/2.
   void symmetrize();
@@ -105,7 +116,7 @@ class FilterState {
   /// states (IMU and clones) moves every pose; IMU part at `imu`
   /// (δp = e_z × (p − c), δv = e_z × v, δθ = R_W_Bᵀ e_z), clone parts at
   /// their first estimates (δp_C = e_z × (p_C − c), δθ_C = R_W_Cᵀ e_z), zero
-  /// for the anchored features and the biases. Global translation t is
+  /// for the anchored features, the scene depth and the biases. Global translation t is
   /// unobservable too, and every model of the backend is exactly invariant to
   /// it (H t = 0 at any linearisation point); rotating about the centroid makes
   /// n orthogonal to t, so the constraint H ← H − (H n) nᵀ/|n|² keeps H t = 0.
@@ -115,8 +126,8 @@ class FilterState {
   VecX yawDirection(const ImuState& imu) const;
 
   /// The error-state difference x ⊟ ref (the inverse of correct(): ref with
-  /// correct(x ⊟ ref) gives x). Both states must have the same clones and
-  /// features; rotations: Log(R_refᵀ R).
+  /// correct(x ⊟ ref) gives x). Both states must have the same clones,
+  /// features and scene depth; rotations: Log(R_refᵀ R).
   VecX minus(const FilterState& ref) const;
 };
 

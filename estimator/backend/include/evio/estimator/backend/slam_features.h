@@ -46,6 +46,13 @@ Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& e
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
                              double sigma_rho0, double sigma_z, const Mat2& whiten = Mat2::Identity());
 
+/// The same with the depth from the scene's inverse depth ρ_s (the state
+/// must have it): ρ = ρ_s + δ, δ independent with σ_δ = sigma_delta, so
+/// ρ's variance is P_ss + σ_δ² and its cross-covariance with everything is
+/// ρ_s's (docs/algorithms.md "Scene depth").
+void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t c, const Vec2& z,
+                                  double sigma_delta, double sigma_z, const Mat2& whiten);
+
 /// Result of the triangulated initialisation.
 enum class SlamInitOutcome { kOk, kDegenerate, kGateFailed, kUpdateFailed };
 

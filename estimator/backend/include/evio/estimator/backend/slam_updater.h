@@ -38,6 +38,9 @@ class SlamUpdater : public Updater {
   /// (α, β) of every SLAM feature gains q Δt / f² of variance, dt_s the time
   /// since the previous measurement set.
   void diffuseBearings(double dt_s);
+  /// The scene's inverse depth ρ_s (BackendOptions::slam_scene_depth_share)
+  /// random-walks: P_ss += c σ_ρ0² dt_s / slam_scene_depth_memory_s.
+  void diffuseSceneDepth(double dt_s);
   /// Marginalises the SLAM features that the observations do not contain (lost tracks).
   void marginalizeUnobserved(const std::vector<FeatureObservation>& observations);
   /// The observations of SLAM features in clone c (position), each gated with
@@ -69,6 +72,9 @@ class SlamUpdater : public Updater {
   /// prior it would otherwise take (prior_sigma_rho, 1/m).
   bool initializeTriangulated(const FeatureTrack& track, double prior_sigma_rho, bool* done);
   void initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior);
+  /// The fixed prior through the scene depth ρ_s (added to the state at the
+  /// first call) when slam_scene_depth_share > 0 and ρ_s is positive.
+  bool initializeFromSceneDepth(const FeatureTrack& track, std::size_t c, const DepthPrior& fixed);
   /// The fixed prior may be taken: slam_fixed_prior_wait_s has passed since
   /// the filter's initialisation.
   bool fixedPriorAllowed() const;

@@ -164,6 +164,32 @@ TEST(SceneDepthState, FixedPriorFeaturesShareTheSceneDepthWhenTheShareIsSet) {
   EXPECT_EQ(off.state.dim(), 15 + 12 + 6);
 }
 
+TEST(SceneDepthState, TheFirstTriangulatedPointsMeasureTheSceneDepthOnce) {
+  // ρ_s ~ N(1, 0.225) and one feature from it; then three triangulated points
+  // 2, 2.5 and 4 m ahead: the median 1/2.5 = 0.4 measures ρ_s with σ 0.2, so
+  //   ρ_s ← 1 + K (0.4 − 1), K = 0.225 / (0.225 + 0.04),
+  // and the feature, which shares all of ρ_s's variance, moves with it.
+  Bench b(clonesAtRest(2));
+  b.options.slam_min_depth_m = 0.5;
+  b.options.slam_scene_depth_share = 0.9;
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  TrackMap tracks = twoTracksWithoutParallax();
+  ASSERT_TRUE(slam.initialize({3}, &tracks));  // no points yet: nothing measured
+  EXPECT_DOUBLE_EQ(b.state.scene_rho, 1.0);
+  EXPECT_EQ(b.stats.slam_scene_depth_measured, 0);
+  for (const double z : {2.0, 2.5, 4.0}) b.triangulated.add(Vec3(0.3, -0.2, z));
+  ASSERT_TRUE(slam.initialize({}, &tracks));
+  const double K = 0.225 / (0.225 + 0.04);
+  EXPECT_NEAR(b.state.scene_rho, 1.0 + K * (0.4 - 1.0), 1e-12);
+  EXPECT_NEAR(b.state.features[0].abr.z(), 1.0 + K * (0.4 - 1.0), 1e-12);
+  EXPECT_NEAR(b.state.P(b.state.sceneDepthIndex(), b.state.sceneDepthIndex()), 0.225 * (1.0 - K), 1e-12);
+  EXPECT_EQ(b.stats.slam_scene_depth_measured, 1);
+  const double after = b.state.scene_rho;
+  ASSERT_TRUE(slam.initialize({}, &tracks));  // once only: the same points are not evidence again
+  EXPECT_EQ(b.state.scene_rho, after);
+  EXPECT_EQ(b.stats.slam_scene_depth_measured, 1);
+}
+
 TEST(SceneDepthState, AFeatureBehindTheSceneTakesThePlainPrior) {
   // ρ_s driven to a negative value (a scene behind the camera): new features
   // take the independent fixed prior instead.

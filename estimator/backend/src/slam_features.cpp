@@ -97,7 +97,7 @@ void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t 
 
 bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, const Vec3& abr, double sigma2,
                            SlamFeature* f, Mat3* P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>* P_fx, MatX* H2,
-                           VecX* r2, const std::function<void(MatX*)>& constrain) {
+                           VecX* r2, const std::function<void(MatX*)>& constrain, const InverseDepthPrior* prior) {
   if (track.observations.size() < 2) return false;
   const int a = state.findClone(track.observations.back().clone_id);
   if (a < 0) return false;
@@ -105,8 +105,9 @@ bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, 
   std::vector<const TrackObservation*> obs;
   for (const TrackObservation& o : track.observations)
     if (state.findClone(o.clone_id) >= 0) obs.push_back(&o);
-  const Eigen::Index m = 2 * static_cast<Eigen::Index>(obs.size());
-  if (m < 4) return false;
+  const Eigen::Index m_obs = 2 * static_cast<Eigen::Index>(obs.size());
+  if (m_obs < 4) return false;
+  const Eigen::Index m = m_obs + (prior != nullptr ? 1 : 0);
   MatX H_x = MatX::Zero(m, state.dim());
   MatX H_f(m, 3);
   VecX r(m);
@@ -123,6 +124,12 @@ bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, 
     r.segment<2>(row) = obs[i]->whiten * (obs[i]->z - zh);  // whitened to σ_z² I (feature_track.h)
     H_x.middleRows<2>(row) = obs[i]->whiten * H_x.middleRows<2>(row);
     H_f.middleRows<2>(row) = obs[i]->whiten * H_f.middleRows<2>(row);
+  }
+  if (prior != nullptr) {
+    // The prior as one more row, ρ0 = ρ + w with w ~ N(0, σ_ρ0²), whitened to σ_z²; no pose in it.
+    const double w = std::sqrt(sigma2) / prior->sigma;
+    H_f.row(m - 1) = Eigen::RowVector3d(0.0, 0.0, w);
+    r(m - 1) = w * (prior->rho - abr.z());
   }
   if (constrain) constrain(&H_x);
   const Eigen::HouseholderQR<MatX> qr(H_f);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/range_update.h"
 #include "evio/estimator/backend/slam_features.h"
@@ -101,6 +102,7 @@ void SlamUpdater::prune(std::vector<std::size_t> gated_out) {
 
 bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap* tracks) {
   const std::size_t c = state().clones.size() - 1;
+  if (state().has_scene_depth && !scene_depth_measured_) measureSceneDepth(c);
   for (const FeatureId id : candidates) {
     if (static_cast<int>(state().features.size()) >= options().max_slam_features) break;
     auto it = tracks->find(id);
@@ -117,7 +119,12 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
         ++stats().slam_waiting_for_depth;  // stays in the window until the scene's depth is known
         continue;
       }
-      initializeWithPrior(track, c, prior);
+      const PriorWithTrack with_track = initializeWithPriorAndTrack(track, prior);
+      if (with_track == PriorWithTrack::kUpdateFailed) {
+        tracks->erase(it);
+        return false;
+      }
+      if (with_track == PriorWithTrack::kNotUsed) initializeWithPrior(track, c, prior);
     }
     tracks->erase(it);  // the track is a SLAM feature now, or failed its gate
   }
@@ -145,6 +152,29 @@ bool SlamUpdater::initializeTriangulated(const FeatureTrack& track, double prior
   const CameraClone& anchor = clones.back();  // the triangulation's anchor: the track's last clone
   triangulatedPoints().add(anchor.p_W_C + anchor.R_W_C() * Vec3(res.abr.x(), res.abr.y(), 1.0) / res.abr.z());
   return true;
+}
+
+SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const FeatureTrack& track,
+                                                                      const DepthPrior& prior) {
+  if (!options().slam_prior_init_with_track) return PriorWithTrack::kNotUsed;
+  std::vector<CameraClone> clones;
+  std::vector<std::size_t> positions;
+  std::vector<Vec2> z;
+  std::vector<Mat2> whiten;
+  gatherTrack(state(), track, &clones, &positions, &z, &whiten);
+  if (clones.size() < 2) return PriorWithTrack::kNotUsed;
+  const TriangulationOptions tri = triangulationOptions(sigma_z_, prior.sigma);
+  Vec3 abr;
+  if (!refineWithDepthPrior(clones, z, whiten, clones.size() - 1, prior.rho, prior.sigma, sigma_z_, tri, &abr))
+    return PriorWithTrack::kNotUsed;
+  const InverseDepthPrior row{prior.rho, prior.sigma};
+  const SlamInitOutcome outcome =
+      addSlamFeatureTriangulated(state(), track, abr, sigma_z_ * sigma_z_, options().joseph_form, *msckf_chi2_,
+                                 [this](MatX* H) { constrain(H); }, &row);
+  if (outcome == SlamInitOutcome::kUpdateFailed) return PriorWithTrack::kUpdateFailed;
+  if (outcome != SlamInitOutcome::kOk) return PriorWithTrack::kNotUsed;
+  ++stats().slam_initialized_prior_track;
+  return PriorWithTrack::kDone;
 }
 
 bool SlamUpdater::fixedPriorAllowed() const {
@@ -180,6 +210,21 @@ void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c, 
     case DepthPrior::Source::kMap: ++stats().slam_initialized_map; break;
     case DepthPrior::Source::kFixed: ++stats().slam_initialized_prior; break;
   }
+}
+
+void SlamUpdater::measureSceneDepth(std::size_t c) {
+  // Only the triangulated points (MSCKF features and triangulated SLAM
+  // initialisations, none of them in the state): the SLAM features that
+  // converged may be the fixed-prior ones themselves.
+  const auto rho = medianInverseDepth(state().clones[c], triangulatedPoints().points(), options().map_prior_min_points);
+  if (!rho) return;
+  scene_depth_measured_ = true;
+  // ρ_map = ρ_s + v, v ~ N(0, (ρ_map/2)²): the map prior's σ for one feature.
+  MatX H = MatX::Zero(1, state().dim());
+  H(0, state().sceneDepthIndex()) = 1.0;
+  VecX r(1);
+  r(0) = *rho - state().scene_rho;
+  if (ekfUpdate(state(), H, r, 0.25 * *rho * *rho, options().joseph_form)) ++stats().slam_scene_depth_measured;
 }
 
 bool SlamUpdater::initializeFromSceneDepth(const FeatureTrack& track, std::size_t c, const DepthPrior& fixed) {

@@ -88,6 +88,61 @@ bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vecto
   return true;
 }
 
+bool refineWithDepthPrior(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
+                          const std::vector<Mat2>& whiten, std::size_t anchor, double rho0, double sigma_rho0,
+                          double sigma_z, const TriangulationOptions& options, Vec3* abr) {
+  const std::size_t n = clones.size();
+  if (n < 1 || z.size() != n || whiten.size() != n || anchor >= n || !(sigma_rho0 > 0.0) || !(sigma_z > 0.0))
+    return false;
+  const double w_prior = sigma_z / sigma_rho0;  // the prior row whitened to σ_z
+  const auto rows = static_cast<Eigen::Index>(2 * n + 1);
+  Eigen::MatrixXd J(rows, 3);
+  Eigen::VectorXd r(rows);
+  // Residuals (and Jacobians ∂ẑ/∂x, the GN convention of triangulateFeature) at x.
+  auto evaluate = [&](const Vec3& x, bool jac) {
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec2 zi;
+      Mat23 Ji;
+      if (!projectAnchoredFeature(clones[anchor], clones[i], x, &zi, nullptr, nullptr, jac ? &Ji : nullptr))
+        return false;
+      const auto row = 2 * static_cast<Eigen::Index>(i);
+      r.segment<2>(row) = whiten[i] * (z[i] - zi);
+      if (jac) J.block<2, 3>(row, 0) = whiten[i] * Ji;
+    }
+    r(rows - 1) = w_prior * (rho0 - x.z());
+    if (jac) J.row(rows - 1) = Eigen::RowVector3d(0.0, 0.0, w_prior);
+    return true;
+  };
+  Vec3 x(z[anchor].x(), z[anchor].y(), rho0);
+  if (!evaluate(x, true)) return false;
+  double cost = r.squaredNorm();
+  for (int it = 0; it < options.max_iterations; ++it) {
+    const Mat3 JtJ = J.transpose() * J;
+    Vec3 step = JtJ.ldlt().solve(J.transpose() * r);
+    if (!step.allFinite()) return false;
+    double scale = 1.0;
+    bool fell = false;
+    for (int halving = 0; halving <= 10; ++halving, scale *= 0.5) {
+      const Vec3 trial = x + scale * step;
+      if (trial.z() > 0.0 && evaluate(trial, false) && r.squaredNorm() <= cost) {
+        x = trial;
+        cost = r.squaredNorm();
+        fell = true;
+        break;
+      }
+    }
+    if (!fell) break;  // no step lowers the cost: x is the minimum found
+    if (!evaluate(x, true)) return false;
+    if (scale * step.norm() <= options.tolerance * x.norm()) break;
+  }
+  if (!(x.z() > 0.0)) return false;
+  const Vec3 p_W = anchoredToWorld(clones[anchor], x);
+  for (const CameraClone& c : clones)
+    if (!((c.R_W_C().transpose() * (p_W - c.p_W_C)).z() >= options.min_depth_m)) return false;
+  *abr = x;
+  return true;
+}
+
 bool knowsDepth(const TriangulationResult& result, const TriangulationOptions& options) {
   return !(options.max_sigma_rho > 0.0) || options.sigma_z * result.sigma_rho_unit <= options.max_sigma_rho;
 }

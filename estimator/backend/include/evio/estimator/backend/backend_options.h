@@ -79,6 +79,13 @@ struct BackendOptions {
   double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
   int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
+  /// A feature that takes a depth prior (fixed, map or range) takes it
+  /// together with its track's observations in the window: the MAP (α, β, ρ)
+  /// of track and prior, then the prior as one more row of the triangulated
+  /// initialisation's split (docs/algorithms.md "Depth prior with the
+  /// track"). Off: the prior alone at the last observation, the track's
+  /// earlier observations unused (xVIO).
+  bool slam_prior_init_with_track = false;
   /// Add the covariance of the bilinear ρ·(clone error) term that the EKF's
   /// linearisation drops to each SLAM observation's noise
   /// (slamSecondOrderCovariance in slam_features.h): the inflation is large
@@ -222,6 +229,8 @@ struct BackendOptions {
     v("slam_gate_probability", slam_gate_probability, "SLAM Mahalanobis gate probability");
     v("slam_max_gate_failures", slam_max_gate_failures, "gate failures removing a SLAM feature");
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
+    v("slam_prior_init_with_track", slam_prior_init_with_track,
+      "a depth-prior SLAM initialisation also uses the track's observations in the window");
     v("slam_second_order_noise", slam_second_order_noise,
       "SLAM observation noise includes the second-order inverse-depth term");
     v("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s,

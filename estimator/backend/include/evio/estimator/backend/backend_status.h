@@ -42,7 +42,9 @@ struct BackendStats {
   std::int64_t slam_initialized_triangulated = 0;
   std::int64_t slam_initialized_prior = 0;
   std::int64_t slam_initialized_range = 0;  ///< depth prior from the range finder
+  std::int64_t slam_initialized_prior_track = 0;  ///< a depth prior with the track's observations (slam_prior_init_with_track)
   std::int64_t slam_initialized_map = 0;    ///< depth prior from the map's median depth
+  std::int64_t slam_scene_depth_measured = 0;  ///< updates of the scene depth from the triangulated points (0 or 1)
   std::int64_t slam_waiting_for_depth = 0;  ///< waits of SLAM candidates for a depth, per set (slam_fixed_prior_wait_s)
   std::int64_t slam_updates_rejected = 0;  ///< Mahalanobis gate
   std::int64_t slam_features_removed = 0;  ///< lost, gated out or invalid
@@ -68,7 +70,11 @@ struct BackendStats {
     v("slam_initialized_triangulated", slam_initialized_triangulated, "slam initialized triangulated");
     v("slam_initialized_prior", slam_initialized_prior, "slam initialized prior");
     v("slam_initialized_range", slam_initialized_range, "SLAM features initialised with a range-finder depth prior");
+    v("slam_initialized_prior_track", slam_initialized_prior_track,
+      "SLAM features initialised from a depth prior and the track's observations together");
     v("slam_initialized_map", slam_initialized_map, "SLAM features initialised with the map's depth prior");
+    v("slam_scene_depth_measured", slam_scene_depth_measured,
+      "updates of the scene inverse depth from the triangulated points' median (0 or 1)");
     v("slam_waiting_for_depth", slam_waiting_for_depth, "SLAM candidates left waiting for a depth, counted once per measurement set");
     v("slam_updates_rejected", slam_updates_rejected, "SLAM observations rejected by the Mahalanobis gate");
     v("slam_features_removed", slam_features_removed, "SLAM features removed: lost, gated out or invalid");

@@ -53,6 +53,12 @@ void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, co
 void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t c, const Vec2& z,
                                   double sigma_delta, double sigma_z, const Mat2& whiten);
 
+/// A prior on a new feature's inverse depth, ρ ~ N(rho, sigma²), 1/m.
+struct InverseDepthPrior {
+  double rho = 0.0;
+  double sigma = 0.0;
+};
+
 /// Result of the triangulated initialisation.
 enum class SlamInitOutcome { kOk, kDegenerate, kGateFailed, kUpdateFailed };
 
@@ -66,11 +72,15 @@ enum class SlamInitOutcome { kOk, kDegenerate, kGateFailed, kUpdateFailed };
 /// and the rest (Q2ᵀ H_x, Q2ᵀ r) is an ordinary update, χ²-gated with threshold
 /// `chi2_threshold(dof)`. Needs at least 2 observations. `constrain(H)` is
 /// applied to H_x before the split (the backend's observability constraint;
-/// pass a no-op to disable).
+/// pass a no-op to disable). With `prior`, the stack holds one more row,
+/// the depth prior ρ0 = ρ + w (w ~ N(0, σ_ρ0²)) whitened to σ²: the
+/// initialisation from a track too short to fix its depth alone
+/// (docs/algorithms.md "Depth prior with the track"); abr should then be
+/// refineWithDepthPrior's answer.
 template <class Chi2, class Constrain>
 SlamInitOutcome addSlamFeatureTriangulated(FilterState& state, const FeatureTrack& track, const Vec3& abr,
                                            double sigma2, bool joseph, const Chi2& chi2_threshold,
-                                           const Constrain& constrain);
+                                           const Constrain& constrain, const InverseDepthPrior* prior = nullptr);
 
 /// Re-anchors feature j onto clone `to` (positions in the state): the mean by
 /// reanchorFeature() and the covariance by P ← T P Tᵀ, T the identity with the
@@ -88,27 +98,31 @@ bool reanchorSlamFeature(FilterState& state, std::size_t j, std::size_t to, cons
 /// P_ff, P_fx and the remaining update (H2, r2). False when degenerate.
 bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, const Vec3& abr, double sigma2,
                            SlamFeature* f, Mat3* P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>* P_fx, MatX* H2,
-                           VecX* r2, const std::function<void(MatX*)>& constrain);
+                           VecX* r2, const std::function<void(MatX*)>& constrain,
+                           const InverseDepthPrior* prior = nullptr);
 double slamMahalanobis(const FilterState& state, const MatX& H, const VecX& r, double sigma2);
 bool slamUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph);
 
 template <class Chi2, class Constrain>
 SlamInitOutcome addSlamFeatureTriangulated(FilterState& state, const FeatureTrack& track, const Vec3& abr,
                                            double sigma2, bool joseph, const Chi2& chi2_threshold,
-                                           const Constrain& constrain) {
+                                           const Constrain& constrain, const InverseDepthPrior* prior) {
   SlamFeature f;
   Mat3 P_ff;
   Eigen::Matrix<double, 3, Eigen::Dynamic> P_fx;
   MatX H2;
   VecX r2;
-  if (!splitTriangulatedInit(state, track, abr, sigma2, &f, &P_ff, &P_fx, &H2, &r2, constrain))
+  if (!splitTriangulatedInit(state, track, abr, sigma2, &f, &P_ff, &P_fx, &H2, &r2, constrain, prior))
     return SlamInitOutcome::kDegenerate;
   if (r2.size() > 0 && slamMahalanobis(state, H2, r2, sigma2) > chi2_threshold(static_cast<int>(r2.size())))
     return SlamInitOutcome::kGateFailed;
+  const int k = state.featureIndex(state.features.size());  // where the feature goes (before ρ_s)
   state.addFeature(f, P_ff, P_fx);
   if (r2.size() == 0) return SlamInitOutcome::kOk;
-  H2.conservativeResize(Eigen::NoChange, state.dim());
-  H2.rightCols(3).setZero();
+  MatX H2_new = MatX::Zero(H2.rows(), state.dim());  // the new feature's columns are zero
+  H2_new.leftCols(k) = H2.leftCols(k);
+  H2_new.rightCols(H2.cols() - k) = H2.rightCols(H2.cols() - k);
+  H2.swap(H2_new);
   return slamUpdate(state, H2, r2, sigma2, joseph) ? SlamInitOutcome::kOk : SlamInitOutcome::kUpdateFailed;
 }
 

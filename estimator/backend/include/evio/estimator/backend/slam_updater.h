@@ -72,9 +72,21 @@ class SlamUpdater : public Updater {
   /// prior it would otherwise take (prior_sigma_rho, 1/m).
   bool initializeTriangulated(const FeatureTrack& track, double prior_sigma_rho, bool* done);
   void initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior);
+  /// With slam_prior_init_with_track: the track's observations in the window
+  /// and the depth prior together (refineWithDepthPrior, then the split of
+  /// addSlamFeatureTriangulated with the prior as one more row). kNotUsed
+  /// (the caller takes the plain prior) when the option is off, the track has
+  /// one observation, the refinement fails or the rest fails its gate.
+  enum class PriorWithTrack { kDone, kNotUsed, kUpdateFailed };
+  PriorWithTrack initializeWithPriorAndTrack(const FeatureTrack& track, const DepthPrior& prior);
   /// The fixed prior through the scene depth ρ_s (added to the state at the
   /// first call) when slam_scene_depth_share > 0 and ρ_s is positive.
   bool initializeFromSceneDepth(const FeatureTrack& track, std::size_t c, const DepthPrior& fixed);
+  /// Once, when the triangulated points first give the scene's depth seen
+  /// from clone c: ρ_s updated with their median inverse depth ρ_map as a
+  /// measurement of σ ρ_map/2, which moves every feature that took the fixed
+  /// prior through its correlation with ρ_s.
+  void measureSceneDepth(std::size_t c);
   /// The fixed prior may be taken: slam_fixed_prior_wait_s has passed since
   /// the filter's initialisation.
   bool fixedPriorAllowed() const;
@@ -89,6 +101,7 @@ class SlamUpdater : public Updater {
   const Chi2Table* slam_chi2_;
   const Chi2Table* msckf_chi2_;
   const RangeUpdater* range_;
+  bool scene_depth_measured_ = false;
 };
 
 }  // namespace evio::estimator

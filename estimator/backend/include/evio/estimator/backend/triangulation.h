@@ -50,6 +50,21 @@ struct TriangulationResult {
 bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
                         std::size_t anchor, const TriangulationOptions& options, TriangulationResult* result);
 
+/// The maximum a posteriori (α, β, ρ) of a feature anchored in clones[anchor]
+/// from its observations z[i] (whitening whiten[i] to σ_z², feature_track.h)
+/// and a prior ρ ~ N(rho0, sigma_rho0²), the clone poses held fixed:
+/// Gauss–Newton on
+///   Σ_i ‖W_i (z_i − π(h_i(α, β, ρ)))‖² + (σ_z/σ_ρ0)² (ρ − ρ0)²
+/// from (z_anchor, ρ0), each step halved until the cost falls (at most 10
+/// times). Where the track has no parallax the data say nothing about ρ and
+/// the answer is ρ0; with some parallax ρ moves as far as the data outweigh
+/// the prior, which one linearised update at ρ0 does not do when ρ0 is far
+/// off. False when a step fails or the point ends behind or nearer than
+/// options.min_depth_m to a clone (docs/algorithms.md "Depth prior with the track").
+bool refineWithDepthPrior(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
+                          const std::vector<Mat2>& whiten, std::size_t anchor, double rho0, double sigma_rho0,
+                          double sigma_z, const TriangulationOptions& options, Vec3* abr);
+
 /// Whether the track's observations fix the inverse depth to within
 /// options.max_sigma_rho: σ_z · sigma_rho_unit ≤ max_sigma_rho (always true
 /// when max_sigma_rho is 0).

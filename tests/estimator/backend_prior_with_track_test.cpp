@@ -1,0 +1,166 @@
+// A depth prior taken together with the track's observations
+// (BackendOptions::slam_prior_init_with_track; triangulation.h
+// refineWithDepthPrior, slam_features.h addSlamFeatureTriangulated with a
+// prior row): the MAP answer against its own cost, the two limits (no
+// parallax: the prior; no prior weight: the point), and the split.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "evio/estimator/backend/slam_features.h"
+#include "evio/estimator/backend/slam_updater.h"
+#include "evio/estimator/backend/triangulation.h"
+#include "evio/estimator/backend/visual_models.h"
+
+namespace evio::estimator {
+namespace {
+
+const Camera kCamera = Camera(PinholeCamera(200, 100, Vec4(100, 100, 100, 50)));
+
+/// n clones looking along +z of W, at x = baseline · i (m).
+std::vector<CameraClone> clonesAlongX(int n, double baseline) {
+  std::vector<CameraClone> out;
+  for (int i = 0; i < n; ++i) {
+    CameraClone c;
+    c.id = i;
+    c.p_W_C = c.p_fej = Vec3(baseline * i, 0.0, 0.0);
+    out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<Vec2> observe(const std::vector<CameraClone>& clones, const Vec3& p_W, const std::vector<Vec2>& noise) {
+  std::vector<Vec2> z;
+  for (std::size_t i = 0; i < clones.size(); ++i) {
+    Vec2 zi;
+    EXPECT_TRUE(projectWorldPoint(clones[i], p_W, &zi));
+    z.push_back(zi + noise[i % noise.size()]);
+  }
+  return z;
+}
+
+/// The MAP cost, written out on its own: Σ‖W(z − ẑ)‖² + (σ_z/σ_ρ0)² (ρ − ρ0)².
+double mapCost(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z, const Vec3& abr, double rho0,
+               double sigma_rho0, double sigma_z) {
+  double cost = 0.0;
+  for (std::size_t i = 0; i < clones.size(); ++i) {
+    Vec2 zh;
+    if (!projectAnchoredFeature(clones.back(), clones[i], abr, &zh)) return 1e300;
+    cost += (z[i] - zh).squaredNorm();
+  }
+  const double w = sigma_z / sigma_rho0;
+  return cost + w * w * (abr.z() - rho0) * (abr.z() - rho0);
+}
+
+TEST(PriorWithTrack, WithoutParallaxTheAnswerIsThePrior) {
+  const std::vector<CameraClone> clones = clonesAlongX(6, 0.0);
+  const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2(0.001, -0.002), Vec2(-0.001, 0.0)});
+  const std::vector<Mat2> W(clones.size(), Mat2::Identity());
+  Vec3 abr;
+  ASSERT_TRUE(refineWithDepthPrior(clones, z, W, clones.size() - 1, 1.0, 0.5, 0.01, TriangulationOptions{}, &abr));
+  EXPECT_NEAR(abr.z(), 1.0, 1e-12);  // the data do not see ρ at all
+  // (α, β): the mean of the bearings, which is where Σ‖z_i − (α, β)‖² is least.
+  Vec2 mean = Vec2::Zero();
+  for (const Vec2& zi : z) mean += zi / static_cast<double>(z.size());
+  EXPECT_LT((abr.head<2>() - mean).norm(), 1e-12);
+}
+
+TEST(PriorWithTrack, WithParallaxAndAWeakPriorTheAnswerIsThePoint) {
+  // A point 4 m away (ρ = 0.25) seen over 0.6 m of baseline without noise;
+  // a prior at ρ0 = 1 with σ 1e4 weighs nothing.
+  const std::vector<CameraClone> clones = clonesAlongX(7, 0.1);
+  const Vec3 p_W(0.3, -0.2, 4.0);
+  const std::vector<Vec2> z = observe(clones, p_W, {Vec2::Zero()});
+  const std::vector<Mat2> W(clones.size(), Mat2::Identity());
+  Vec3 abr;
+  ASSERT_TRUE(refineWithDepthPrior(clones, z, W, clones.size() - 1, 1.0, 1e4, 0.01, TriangulationOptions{}, &abr));
+  EXPECT_LT((anchoredToWorld(clones.back(), abr) - p_W).norm(), 1e-6);
+}
+
+TEST(PriorWithTrack, TheAnswerIsTheLeastOfTheMapCost) {
+  // Noisy observations over a short baseline and the prior 1.5 σ from the
+  // truth: the answer lies between them, and no nearby point costs less.
+  const std::vector<CameraClone> clones = clonesAlongX(10, 0.01);
+  const std::vector<Vec2> z =
+      observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2(0.004, -0.002), Vec2(-0.003, 0.001), Vec2(0.0, 0.005)});
+  const std::vector<Mat2> W(clones.size(), Mat2::Identity());
+  const double rho0 = 1.0, sigma0 = 0.5, sigma_z = 0.025;
+  TriangulationOptions opt;
+  opt.max_iterations = 50;
+  opt.tolerance = 1e-12;
+  Vec3 abr;
+  ASSERT_TRUE(refineWithDepthPrior(clones, z, W, clones.size() - 1, rho0, sigma0, sigma_z, opt, &abr));
+  EXPECT_GT(abr.z(), 0.0);
+  EXPECT_LT(abr.z(), 0.9);  // the data pulled it from the prior towards 0.25
+  const double best = mapCost(clones, z, abr, rho0, sigma0, sigma_z);
+  for (int k = 0; k < 3; ++k) {
+    for (const double h : {-1e-4, 1e-4}) {
+      Vec3 x = abr;
+      x(k) += h;
+      EXPECT_GE(mapCost(clones, z, x, rho0, sigma0, sigma_z), best) << k << " " << h;
+    }
+  }
+}
+
+TEST(PriorWithTrack, TheSplitWithoutParallaxGivesThePriorsDepthAndUsesEveryBearing) {
+  // Clones at one pose: the observations say nothing about ρ, so the
+  // feature's ρ has the prior's mean and variance and no correlation with
+  // the clones; (α, β) are fixed by all observations.
+  FilterState s;
+  for (const CameraClone& c : clonesAlongX(5, 0.0)) s.clones.push_back(c);
+  s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
+  FeatureTrack track;
+  track.id = 9;
+  for (const CameraClone& c : s.clones) track.observations.push_back({c.id, Vec2(0.1, 0.05)});
+  const InverseDepthPrior prior{0.8, 0.4};
+  const double sigma_z = 0.01;
+  const auto outcome = addSlamFeatureTriangulated(
+      s, track, Vec3(0.1, 0.05, 0.8), sigma_z * sigma_z, true, [](int) { return 1e9; }, [](MatX*) {}, &prior);
+  ASSERT_EQ(outcome, SlamInitOutcome::kOk);
+  ASSERT_EQ(s.features.size(), 1u);
+  const int k = s.featureIndex(0);
+  EXPECT_NEAR(s.features[0].abr.z(), 0.8, 1e-12);
+  EXPECT_NEAR(s.P(k + 2, k + 2), 0.4 * 0.4, 1e-12);
+  EXPECT_LT(s.P.row(k + 2).head(k).cwiseAbs().maxCoeff(), 1e-15);
+  // Five observations of one bearing: its variance below one observation's.
+  EXPECT_LT(s.P(k, k), sigma_z * sigma_z);
+}
+
+struct Bench {
+  explicit Bench(FilterState s) : state(std::move(s)), fej(state.imu) {}
+  UpdaterContext context() {
+    return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated, &initialized_at};
+  }
+  FilterState state;
+  ImuState fej;
+  BackendOptions options;
+  BackendStats stats;
+  TriangulatedPoints triangulated{30};
+  TimeNs initialized_at = 0;
+  Chi2Table chi2{0.95};
+};
+
+TEST(PriorWithTrack, TheSlamUpdaterTakesThePriorWithTheTrackWhenAsked) {
+  for (const bool with_track : {false, true}) {
+    FilterState s;
+    for (const CameraClone& c : clonesAlongX(4, 0.0)) s.clones.push_back(c);
+    s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
+    Bench b(s);
+    b.options.slam_min_depth_m = 0.5;
+    b.options.slam_prior_init_with_track = with_track;
+    SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+    FeatureTrack t;
+    t.id = 3;
+    for (const CameraClone& c : b.state.clones) t.observations.push_back({c.id, Vec2(0.2, 0.1)});
+    TrackMap tracks{{3, t}};
+    ASSERT_TRUE(slam.initialize({3}, &tracks));
+    ASSERT_EQ(b.state.features.size(), 1u);
+    EXPECT_NEAR(b.state.features[0].abr.z(), 1.0, 1e-12) << with_track;
+    EXPECT_EQ(b.stats.slam_initialized_prior_track, with_track ? 1 : 0);
+    EXPECT_EQ(b.stats.slam_initialized_prior, with_track ? 0 : 1);
+    EXPECT_TRUE(tracks.empty());
+  }
+}
+
+}  // namespace
+}  // namespace evio::estimator

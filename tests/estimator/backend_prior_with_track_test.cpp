@@ -162,11 +162,11 @@ TEST(PriorWithTrack, TheSlamUpdaterTakesThePriorWithTheTrackWhenAsked) {
   }
 }
 
-TEST(PriorWithTrack, AParallaxThresholdAndPosesLeftAloneWhenAsked) {
+TEST(PriorWithTrack, BelowTheParallaxThresholdThePriorIsTakenAlone) {
   // A point 4 m away over a 0.3 m baseline (4 clones 0.1 m apart): about
   // 7.5 px of rotation-compensated disparity at f = 100 px.
   const Vec3 p_W(0.3, -0.2, 4.0);
-  auto run = [&](double min_parallax_px, bool update_poses, BackendStats* stats, MatX* clone_P) {
+  auto run = [&](double min_parallax_px, BackendStats* stats, MatX* clone_P) {
     FilterState s;
     for (const CameraClone& c : clonesAlongX(4, 0.1)) s.clones.push_back(c);
     s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
@@ -175,7 +175,6 @@ TEST(PriorWithTrack, AParallaxThresholdAndPosesLeftAloneWhenAsked) {
     b.options.slam_triangulated_init = false;
     b.options.slam_prior_init_with_track = true;
     b.options.slam_prior_track_min_parallax_px = min_parallax_px;
-    b.options.slam_prior_track_update_poses = update_poses;
     SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
     FeatureTrack t;
     t.id = 3;
@@ -190,17 +189,13 @@ TEST(PriorWithTrack, AParallaxThresholdAndPosesLeftAloneWhenAsked) {
   BackendStats stats;
   MatX clone_P;
   // Above the threshold: the track moves ρ from the prior's 1 towards 0.25.
-  EXPECT_LT(run(5.0, true, &stats, &clone_P), 0.5);
+  EXPECT_LT(run(5.0, &stats, &clone_P), 0.5);
   EXPECT_EQ(stats.slam_initialized_prior_track, 1);
   EXPECT_LT(clone_P.trace(), 24e-6);  // the remaining rows updated the clones
   // Below it (10 px asked): the plain prior.
-  EXPECT_DOUBLE_EQ(run(10.0, true, &stats, &clone_P), 1.0);
+  EXPECT_DOUBLE_EQ(run(10.0, &stats, &clone_P), 1.0);
   EXPECT_EQ(stats.slam_initialized_prior, 1);
   EXPECT_EQ(stats.slam_initialized_prior_track, 0);
-  // The poses left alone: the same feature, the clones' covariance untouched.
-  EXPECT_LT(run(0.0, false, &stats, &clone_P), 0.5);
-  EXPECT_EQ(stats.slam_initialized_prior_track, 1);
-  EXPECT_TRUE(clone_P.isApprox(1e-6 * MatX::Identity(24, 24), 1e-15));
 }
 
 }  // namespace

@@ -170,21 +170,6 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const Featu
   if (!refineWithDepthPrior(clones, z, whiten, clones.size() - 1, prior.rho, prior.sigma, sigma_z_, tri, &abr))
     return PriorWithTrack::kNotUsed;
   const InverseDepthPrior row{prior.rho, prior.sigma};
-  if (!options().slam_prior_track_update_poses) {
-    // The feature from the split, its remaining rows (what the track says
-    // about the clone poses) left unused.
-    SlamFeature f;
-    Mat3 P_ff;
-    Eigen::Matrix<double, 3, Eigen::Dynamic> P_fx;
-    MatX H2;
-    VecX r2;
-    if (!splitTriangulatedInit(state(), track, abr, sigma_z_ * sigma_z_, &f, &P_ff, &P_fx, &H2, &r2,
-                               [this](MatX* H) { constrain(H); }, &row))
-      return PriorWithTrack::kNotUsed;
-    state().addFeature(f, P_ff, P_fx);
-    ++stats().slam_initialized_prior_track;
-    return PriorWithTrack::kDone;
-  }
   const SlamInitOutcome outcome =
       addSlamFeatureTriangulated(state(), track, abr, sigma_z_ * sigma_z_, options().joseph_form, *msckf_chi2_,
                                  [this](MatX* H) { constrain(H); }, &row);

@@ -89,10 +89,6 @@ struct BackendOptions {
   /// The rotation-compensated disparity a track needs before it is taken
   /// with the prior, px (below: the prior alone).
   double slam_prior_track_min_parallax_px = 0.0;
-  /// Whether the split's remaining rows (what the track says about the clone
-  /// poses, once the feature is taken out) update the state; false: only the
-  /// feature's own mean and covariance come from the track and the prior.
-  bool slam_prior_track_update_poses = true;
   /// Add the covariance of the bilinear ρ·(clone error) term that the EKF's
   /// linearisation drops to each SLAM observation's noise
   /// (slamSecondOrderCovariance in slam_features.h): the inflation is large
@@ -240,8 +236,6 @@ struct BackendOptions {
       "a depth-prior SLAM initialisation also uses the track's observations in the window");
     v("slam_prior_track_min_parallax_px", slam_prior_track_min_parallax_px,
       "rotation-compensated disparity a track needs to be taken with the depth prior, px");
-    v("slam_prior_track_update_poses", slam_prior_track_update_poses,
-      "the track taken with the depth prior also updates the clone poses");
     v("slam_second_order_noise", slam_second_order_noise,
       "SLAM observation noise includes the second-order inverse-depth term");
     v("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s,

@@ -83,8 +83,9 @@ struct BackendOptions {
   /// together with its track's observations in the window: the MAP (α, β, ρ)
   /// of track and prior, then the prior as one more row of the triangulated
   /// initialisation's split (docs/algorithms.md "Depth prior with the
-  /// track"). Off: the prior alone at the last observation, the track's
-  /// earlier observations unused (xVIO).
+  /// track"). Off (the default): the prior alone at the last observation,
+  /// the track's earlier observations unused (xVIO); on, it is more accurate
+  /// from the exact start but overconfident when the poses have drifted.
   bool slam_prior_init_with_track = false;
   /// The rotation-compensated disparity a track needs before it is taken
   /// with the prior, px (below: the prior alone).
@@ -117,7 +118,8 @@ struct BackendOptions {
   /// and each fixed-prior feature takes ρ = ρ_s + δ with var δ = (1 − c) σ_ρ0²
   /// and δ independent: the first has the fixed prior's marginal exactly,
   /// later ones start from what the filter has learnt of ρ_s. 0: off
-  /// (independent fixed priors).
+  /// (independent fixed priors), the default: mixed results (README "Depth
+  /// priors that are wrong together").
   double slam_scene_depth_share = 0.0;
   /// ρ_s random-walks (the scene changes as the camera moves): its variance
   /// grows by c σ_ρ0² over this time, s.

@@ -11,6 +11,7 @@
 #include "evio/estimator/backend/slam_updater.h"
 #include "evio/estimator/backend/triangulation.h"
 #include "evio/estimator/backend/visual_models.h"
+#include "updater_bench.h"
 
 namespace evio::estimator {
 namespace {
@@ -27,6 +28,14 @@ std::vector<CameraClone> clonesAlongX(int n, double baseline) {
     out.push_back(c);
   }
   return out;
+}
+
+/// A state holding `clones`, P = 1e-6 I.
+FilterState stateOf(const std::vector<CameraClone>& clones) {
+  FilterState s;
+  s.clones = clones;
+  s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
+  return s;
 }
 
 std::vector<Vec2> observe(const std::vector<CameraClone>& clones, const Vec3& p_W, const std::vector<Vec2>& noise) {
@@ -106,9 +115,7 @@ TEST(PriorWithTrack, TheSplitWithoutParallaxGivesThePriorsDepthAndUsesEveryBeari
   // Clones at one pose: the observations say nothing about ρ, so the
   // feature's ρ has the prior's mean and variance and no correlation with
   // the clones; (α, β) are fixed by all observations.
-  FilterState s;
-  for (const CameraClone& c : clonesAlongX(5, 0.0)) s.clones.push_back(c);
-  s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
+  FilterState s = stateOf(clonesAlongX(5, 0.0));
   FeatureTrack track;
   track.id = 9;
   for (const CameraClone& c : s.clones) track.observations.push_back({c.id, Vec2(0.1, 0.05)});
@@ -126,25 +133,11 @@ TEST(PriorWithTrack, TheSplitWithoutParallaxGivesThePriorsDepthAndUsesEveryBeari
   EXPECT_LT(s.P(k, k), sigma_z * sigma_z);
 }
 
-struct Bench {
-  explicit Bench(FilterState s) : state(std::move(s)), fej(state.imu) {}
-  UpdaterContext context() {
-    return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated, &initialized_at};
-  }
-  FilterState state;
-  ImuState fej;
-  BackendOptions options;
-  BackendStats stats;
-  TriangulatedPoints triangulated{30};
-  TimeNs initialized_at = 0;
-  Chi2Table chi2{0.95};
-};
+using Bench = test::UpdaterBench;
 
 TEST(PriorWithTrack, TheSlamUpdaterTakesThePriorWithTheTrackWhenAsked) {
   for (const bool with_track : {false, true}) {
-    FilterState s;
-    for (const CameraClone& c : clonesAlongX(4, 0.0)) s.clones.push_back(c);
-    s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
+    FilterState s = stateOf(clonesAlongX(4, 0.0));
     Bench b(s);
     b.options.slam_min_depth_m = 0.5;
     b.options.slam_prior_init_with_track = with_track;
@@ -167,9 +160,7 @@ TEST(PriorWithTrack, BelowTheParallaxThresholdThePriorIsTakenAlone) {
   // 7.5 px of rotation-compensated disparity at f = 100 px.
   const Vec3 p_W(0.3, -0.2, 4.0);
   auto run = [&](double min_parallax_px, BackendStats* stats, MatX* clone_P) {
-    FilterState s;
-    for (const CameraClone& c : clonesAlongX(4, 0.1)) s.clones.push_back(c);
-    s.P = 1e-6 * MatX::Identity(s.dim(), s.dim());
+    FilterState s = stateOf(clonesAlongX(4, 0.1));
     Bench b(s);
     b.options.slam_min_depth_m = 0.5;
     b.options.slam_triangulated_init = false;

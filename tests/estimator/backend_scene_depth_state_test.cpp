@@ -11,6 +11,7 @@
 #include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/slam_updater.h"
+#include "updater_bench.h"
 
 namespace evio::estimator {
 namespace {
@@ -101,19 +102,7 @@ TEST(SceneDepthState, OneFeaturesDepthMeasurementMovesTheSceneAndEveryFeatureTha
   EXPECT_NEAR(s.P(r3, s.sceneDepthIndex()), P_ss, 1e-12);
 }
 
-struct Bench {
-  explicit Bench(FilterState s) : state(std::move(s)), fej(state.imu) {}
-  UpdaterContext context() {
-    return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated, &initialized_at};
-  }
-  FilterState state;
-  ImuState fej;
-  BackendOptions options;
-  BackendStats stats;
-  TriangulatedPoints triangulated{30};
-  TimeNs initialized_at = 0;
-  Chi2Table chi2{0.95};
-};
+using Bench = test::UpdaterBench;
 
 TrackMap twoTracksWithoutParallax() {
   TrackMap tracks;

@@ -18,6 +18,7 @@
 #include "evio/estimator/backend/scene_depth.h"
 #include "evio/estimator/backend/slam_updater.h"
 #include "evio/estimator/backend/visual_models.h"
+#include "updater_bench.h"
 
 namespace evio::estimator {
 namespace {
@@ -50,20 +51,7 @@ FilterState restingState(int clones, double p_var = 1e-2) {
   return s;
 }
 
-/// What an updater works on, owned by the test.
-struct UpdaterBench {
-  explicit UpdaterBench(FilterState s) : state(std::move(s)), fej(state.imu) {}
-  UpdaterContext context() {
-    return UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated, &initialized_at};
-  }
-  FilterState state;
-  ImuState fej;
-  BackendOptions options;
-  BackendStats stats;
-  TriangulatedPoints triangulated{30};
-  TimeNs initialized_at = 0;
-  Chi2Table chi2{0.95};
-};
+using test::UpdaterBench;
 
 TEST(BackendSteps, UndistortObservationsGivesNormalisedCoordinatesOncePerFeature) {
   MeasurementSet set;

@@ -22,6 +22,31 @@ double inverseDepthSigma(const Mat3& JtJ) {
   const double schur = JtJ(2, 2) - b.dot(ldlt.solve(b));
   return schur > 0.0 ? 1.0 / std::sqrt(schur) : std::numeric_limits<double>::infinity();
 }
+
+/// The reprojection residuals z_i − π(h_i(x)) of a track anchored in
+/// clones[anchor], whitened by (*whiten)[i] when whiten is given, into the
+/// first 2n rows of r, and their Jacobians ∂ẑ/∂x into the first 2n rows of J
+/// when J is given. False when the point is behind a clone.
+bool trackResiduals(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
+                    const std::vector<Mat2>* whiten, std::size_t anchor, const Vec3& x, Eigen::VectorXd* r,
+                    Eigen::MatrixXd* J) {
+  for (std::size_t i = 0; i < clones.size(); ++i) {
+    Vec2 zi;
+    Mat23 Ji;
+    if (!projectAnchoredFeature(clones[anchor], clones[i], x, &zi, nullptr, nullptr, J != nullptr ? &Ji : nullptr))
+      return false;
+    const auto row = 2 * static_cast<Eigen::Index>(i);
+    if (whiten == nullptr) {
+      r->segment<2>(row) = z[i] - zi;
+      if (J != nullptr) J->block<2, 3>(row, 0) = Ji;
+    } else {
+      r->segment<2>(row) = (*whiten)[i] * (z[i] - zi);
+      if (J != nullptr) J->block<2, 3>(row, 0) = (*whiten)[i] * Ji;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z, std::size_t anchor,
@@ -49,15 +74,7 @@ bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vecto
   Eigen::MatrixXd J(2 * n, 3);
   Eigen::VectorXd r(2 * n);
   auto evaluate = [&](const Vec3& x, bool jac) {
-    for (std::size_t i = 0; i < n; ++i) {
-      Vec2 zi;
-      Mat23 Ji;
-      if (!projectAnchoredFeature(clones[anchor], clones[i], x, &zi, nullptr, nullptr, jac ? &Ji : nullptr))
-        return false;
-      r.segment<2>(2 * static_cast<Eigen::Index>(i)) = z[i] - zi;
-      if (jac) J.block<2, 3>(2 * static_cast<Eigen::Index>(i), 0) = Ji;
-    }
-    return true;
+    return trackResiduals(clones, z, nullptr, anchor, x, &r, jac ? &J : nullptr);
   };
   int it = 0;
   for (; it < options.max_iterations; ++it) {
@@ -100,15 +117,7 @@ bool refineWithDepthPrior(const std::vector<CameraClone>& clones, const std::vec
   Eigen::VectorXd r(rows);
   // Residuals (and Jacobians ∂ẑ/∂x, the GN convention of triangulateFeature) at x.
   auto evaluate = [&](const Vec3& x, bool jac) {
-    for (std::size_t i = 0; i < n; ++i) {
-      Vec2 zi;
-      Mat23 Ji;
-      if (!projectAnchoredFeature(clones[anchor], clones[i], x, &zi, nullptr, nullptr, jac ? &Ji : nullptr))
-        return false;
-      const auto row = 2 * static_cast<Eigen::Index>(i);
-      r.segment<2>(row) = whiten[i] * (z[i] - zi);
-      if (jac) J.block<2, 3>(row, 0) = whiten[i] * Ji;
-    }
+    if (!trackResiduals(clones, z, &whiten, anchor, x, &r, jac ? &J : nullptr)) return false;
     r(rows - 1) = w_prior * (rho0 - x.z());
     if (jac) J.row(rows - 1) = Eigen::RowVector3d(0.0, 0.0, w_prior);
     return true;

@@ -1,0 +1,27 @@
+#pragma once
+/// What an updater (updater.h) works on, owned by a test: the state, the
+/// first-estimate IMU state, options, counters, the triangulated points, the
+/// initialisation time and a χ² table.
+
+#include <utility>
+
+#include "evio/estimator/backend/chi_squared.h"
+#include "evio/estimator/backend/updater.h"
+
+namespace evio::test {
+
+struct UpdaterBench {
+  explicit UpdaterBench(estimator::FilterState s) : state(std::move(s)), fej(state.imu) {}
+  estimator::UpdaterContext context() {
+    return estimator::UpdaterContext{&state, &fej, &options, &stats, nullptr, &triangulated, &initialized_at};
+  }
+  estimator::FilterState state;
+  estimator::ImuState fej;
+  estimator::BackendOptions options;
+  estimator::BackendStats stats;
+  estimator::TriangulatedPoints triangulated{30};
+  TimeNs initialized_at = 0;
+  estimator::Chi2Table chi2{0.95};
+};
+
+}  // namespace evio::test

@@ -187,6 +187,7 @@ TEST(PriorWithTrack, BelowTheParallaxThresholdThePriorIsTakenAlone) {
   EXPECT_DOUBLE_EQ(run(10.0, &stats, &clone_P), 1.0);
   EXPECT_EQ(stats.slam_initialized_prior, 1);
   EXPECT_EQ(stats.slam_initialized_prior_track, 0);
+  EXPECT_TRUE(clone_P.isApprox(1e-6 * MatX::Identity(24, 24), 1e-15));  // no update of the clones
 }
 
 }  // namespace

@@ -60,6 +60,41 @@ TEST(SceneDepthState, TheSceneDepthIsTheLastEntryAndFeaturesGoBeforeIt) {
   EXPECT_EQ(s.yawDirection(s.imu)(s.sceneDepthIndex()), 0.0);
 }
 
+TEST(SceneDepthState, ClonesAndFeaturesComeAndGoAroundTheSceneDepth) {
+  // A clone added, the oldest removed, the feature re-anchored and removed:
+  // ρ_s stays the last entry with its variance, and its covariance with the
+  // feature follows the feature.
+  FilterState s = clonesAtRest(2);
+  s.clones[1].p_W_C = s.clones[1].p_fej = Vec3(0.2, 0.0, 0.0);
+  s.addSceneDepth(0.8, 0.09);
+  addSlamFeatureFromSceneDepth(s, 5, 0, Vec2(0.1, -0.05), 0.2, 0.01, Mat2::Identity());
+  const double P_ss = s.P(s.sceneDepthIndex(), s.sceneDepthIndex());
+  EXPECT_NEAR(s.P(s.featureIndex(0) + 2, s.sceneDepthIndex()), 0.09, 1e-15);
+
+  Eigen::Matrix<double, kCloneDim, Eigen::Dynamic> J = Eigen::Matrix<double, kCloneDim, Eigen::Dynamic>::Zero(6, s.dim());
+  J.block<3, 3>(0, kIdxP).setIdentity();
+  J.block<3, 3>(3, kIdxTheta).setIdentity();
+  CameraClone c;
+  c.id = 7;
+  s.addClone(c, J);
+  ASSERT_EQ(s.clones.size(), 3u);
+  EXPECT_EQ(s.sceneDepthIndex(), s.dim() - 1);
+  EXPECT_EQ(s.P(s.sceneDepthIndex(), s.sceneDepthIndex()), P_ss);
+  EXPECT_NEAR(s.P(s.featureIndex(0) + 2, s.sceneDepthIndex()), 0.09, 1e-15);
+  EXPECT_TRUE(s.P.block(s.cloneIndex(2), s.sceneDepthIndex(), 6, 1).isZero(0.0));  // the IMU's cov with ρ_s
+
+  ASSERT_TRUE(reanchorSlamFeature(s, 0, 1));  // the anchor moves 0.2 m: ρ' = ρ / h_z, so cov(ρ', ρ_s) = ∂ρ'/∂f cov(f, ρ_s)
+  EXPECT_EQ(s.P(s.sceneDepthIndex(), s.sceneDepthIndex()), P_ss);
+  EXPECT_GT(s.P(s.featureIndex(0) + 2, s.sceneDepthIndex()), 0.0);
+  s.removeClone(0);
+  EXPECT_EQ(s.sceneDepthIndex(), s.dim() - 1);
+  EXPECT_EQ(s.P(s.sceneDepthIndex(), s.sceneDepthIndex()), P_ss);
+  s.removeFeature(0);
+  EXPECT_EQ(s.dim(), 15 + 12 + 1);
+  EXPECT_EQ(s.P(s.sceneDepthIndex(), s.sceneDepthIndex()), P_ss);
+  EXPECT_DOUBLE_EQ(s.scene_rho, 0.8);
+}
+
 TEST(SceneDepthState, OneFeaturesDepthMeasurementMovesTheSceneAndEveryFeatureThatSharesIt) {
   // ρ_s ~ N(1, c σ²), ρ_i = ρ_s + δ_i with δ_i ~ N(0, (1 − c) σ²); a direct
   // measurement y = ρ_1 + v, v ~ N(0, r). Exact Gaussian conditioning:

@@ -102,7 +102,7 @@ void SlamUpdater::prune(std::vector<std::size_t> gated_out) {
 
 bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap* tracks) {
   const std::size_t c = state().clones.size() - 1;
-  if (state().has_scene_depth && !scene_depth_measured_) measureSceneDepth(c);
+  if (state().has_scene_depth && !state().scene_depth_measured) measureSceneDepth(c);
   for (const FeatureId id : candidates) {
     if (static_cast<int>(state().features.size()) >= options().max_slam_features) break;
     auto it = tracks->find(id);
@@ -215,18 +215,19 @@ void SlamUpdater::initializeWithPrior(const FeatureTrack& track, std::size_t c, 
 }
 
 void SlamUpdater::measureSceneDepth(std::size_t c) {
-  // Only the triangulated points (MSCKF features and triangulated SLAM
-  // initialisations, none of them in the state): the SLAM features that
-  // converged may be the fixed-prior ones themselves.
+  // Only the triangulated points (MSCKF features, not in the state, and
+  // triangulated SLAM initialisations, which never took the prior): the SLAM
+  // features that converged may be the fixed-prior ones themselves.
   const auto rho = medianInverseDepth(state().clones[c], triangulatedPoints().points(), options().map_prior_min_points);
   if (!rho) return;
-  scene_depth_measured_ = true;
   // ρ_map = ρ_s + v, v ~ N(0, (ρ_map/2)²): the map prior's σ for one feature.
   MatX H = MatX::Zero(1, state().dim());
   H(0, state().sceneDepthIndex()) = 1.0;
   VecX r(1);
   r(0) = *rho - state().scene_rho;
-  if (ekfUpdate(state(), H, r, 0.25 * *rho * *rho, options().joseph_form)) ++stats().slam_scene_depth_measured;
+  if (!ekfUpdate(state(), H, r, 0.25 * *rho * *rho, options().joseph_form)) return;
+  state().scene_depth_measured = true;
+  ++stats().slam_scene_depth_measured;
 }
 
 bool SlamUpdater::initializeFromSceneDepth(const FeatureTrack& track, std::size_t c, const DepthPrior& fixed) {

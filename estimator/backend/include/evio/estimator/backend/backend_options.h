@@ -110,8 +110,8 @@ struct BackendOptions {
   /// in the window, waiting for the map to know the scene's depth
   /// (docs/algorithms.md "Depth prior from the map"). 0: at once.
   double slam_fixed_prior_wait_s = 0.0;
-  /// The scene's inverse depth ρ_s as a state (docs/algorithms.md "Scene
-  /// depth"): every feature that takes the fixed prior shares the prior's
+  /// The scene's inverse depth ρ_s as a state (docs/algorithms.md "The scene's
+  /// depth as a state"): every feature that takes the fixed prior shares the prior's
   /// error (the scene stands at one depth, ρ0 says another), which
   /// independent priors read as scale. With share c in (0, 1), ρ_s enters
   /// the state at the first fixed-prior feature as ρ0 with variance c σ_ρ0²,

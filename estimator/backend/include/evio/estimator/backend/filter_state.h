@@ -11,7 +11,7 @@
 ///
 /// with clones oldest first and features in insertion order; δρ_s, the
 /// scene's inverse depth (1/m), only once it has been added
-/// (BackendOptions::slam_scene_depth_share, docs/algorithms.md "Scene depth").
+/// (BackendOptions::slam_scene_depth_share, docs/algorithms.md "The scene's depth as a state").
 ///
 /// Error-state convention (used by every Jacobian of the backend):
 ///   positions, velocity, biases, feature parameters:  x = x̂ + δx
@@ -74,6 +74,8 @@ class FilterState {
   /// The last error-state entry while has_scene_depth.
   bool has_scene_depth = false;
   double scene_rho = 0.0;
+  /// ρ_s has taken its one measurement from the triangulated points.
+  bool scene_depth_measured = false;
   MatX P;                            ///< error-state covariance (dim × dim), symmetric PD
 
   /// Total error-state dimension 15 + 6 M + 3 N (+ 1 with the scene depth).

@@ -49,7 +49,7 @@ void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, co
 /// The same with the depth from the scene's inverse depth ρ_s (the state
 /// must have it): ρ = ρ_s + δ, δ independent with σ_δ = sigma_delta, so
 /// ρ's variance is P_ss + σ_δ² and its cross-covariance with everything is
-/// ρ_s's (docs/algorithms.md "Scene depth").
+/// ρ_s's (docs/algorithms.md "The scene's depth as a state").
 void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t c, const Vec2& z,
                                   double sigma_delta, double sigma_z, const Mat2& whiten);
 

@@ -101,7 +101,6 @@ class SlamUpdater : public Updater {
   const Chi2Table* slam_chi2_;
   const Chi2Table* msckf_chi2_;
   const RangeUpdater* range_;
-  bool scene_depth_measured_ = false;
 };
 
 }  // namespace evio::estimator

@@ -55,8 +55,8 @@ bool triangulateFeature(const std::vector<CameraClone>& clones, const std::vecto
 /// and a prior ρ ~ N(rho0, sigma_rho0²), the clone poses held fixed:
 /// Gauss–Newton on
 ///   Σ_i ‖W_i (z_i − π(h_i(α, β, ρ)))‖² + (σ_z/σ_ρ0)² (ρ − ρ0)²
-/// from (z_anchor, ρ0), each step halved until the cost falls (at most 10
-/// times). Where the track has no parallax the data say nothing about ρ and
+/// from (z_anchor, ρ0), each step halved until the cost does not rise (at
+/// most 10 times). Where the track has no parallax the data say nothing about ρ and
 /// the answer is ρ0; with some parallax ρ moves as far as the data outweigh
 /// the prior, which one linearised update at ρ0 does not do when ρ0 is far
 /// off. False when a step fails or the point ends behind or nearer than

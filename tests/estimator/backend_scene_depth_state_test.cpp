@@ -18,17 +18,8 @@ namespace {
 
 const Camera kCamera = Camera(PinholeCamera(200, 100, Vec4(100, 100, 100, 50)));
 
-/// Clones 0..n-1 at the origin looking along +z, P = p_var I.
-FilterState clonesAtRest(int n, double p_var = 1e-4) {
-  FilterState s;
-  for (int i = 0; i < n; ++i) {
-    CameraClone c;
-    c.id = i;
-    s.clones.push_back(c);
-  }
-  s.P = p_var * MatX::Identity(s.dim(), s.dim());
-  return s;
-}
+/// Clones 0..n-1 at the origin looking along +z, P = 1e-4 I.
+FilterState clonesAtRest(int n) { return test::restingState(n, 1e-4); }
 
 TEST(SceneDepthState, TheSceneDepthIsTheLastEntryAndFeaturesGoBeforeIt) {
   FilterState s = clonesAtRest(2);

@@ -38,18 +38,7 @@ TrackMap tracksOf(std::vector<FeatureTrack> list) {
   return out;
 }
 
-/// A state with clones 0..n-1 at the origin looking along +z, the IMU at rest,
-/// and P = diag(p_var).
-FilterState restingState(int clones, double p_var = 1e-2) {
-  FilterState s;
-  for (int i = 0; i < clones; ++i) {
-    CameraClone c;
-    c.id = i;
-    s.clones.push_back(c);
-  }
-  s.P = p_var * MatX::Identity(s.dim(), s.dim());
-  return s;
-}
+using test::restingState;
 
 using test::UpdaterBench;
 

@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 
+#include <opencv2/core/utility.hpp>
+
 #include "evio/core/error.h"
 #include "evio/core/slot_ring_thread.h"
 #include "evio/core/stopwatch.h"
@@ -16,6 +18,7 @@
 #include "evio/estimator/pipeline/method.h"
 #include "evio/estimator/pipeline/sequence_rig.h"
 #include "evio/estimator/pipeline/stages.h"
+#include "stage_cpu_split.h"
 
 namespace evio::estimator {
 
@@ -43,19 +46,19 @@ class StageTimer {
   Stopwatch watch_;
 };
 
-/// CPU time of the calling thread between successive laps: lap(&acc) adds
-/// the CPU seconds since the previous lap (or construction) to acc.
-class CpuLap {
+/// OpenCV's parallel loops (the frames' pyramids and filters) on at most
+/// `threads` threads while it lives; with one, on the calling thread alone
+/// (else an idle OpenCV worker spins between frames: 44 000 sched_yield
+/// calls in a 12 s EKLT-VIO run). Their results do not depend on it.
+class OpenCvThreads {
  public:
-  CpuLap() : last_(Stopwatch::threadCpuSeconds()) {}
-  void lap(double* acc) {
-    const double now = Stopwatch::threadCpuSeconds();
-    *acc += now - last_;
-    last_ = now;
-  }
+  explicit OpenCvThreads(int threads) : previous_(cv::getNumThreads()) { cv::setNumThreads(threads > 1 ? threads : 0); }
+  ~OpenCvThreads() { cv::setNumThreads(previous_); }
+  OpenCvThreads(const OpenCvThreads&) = delete;
+  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
 
  private:
-  double last_;
+  int previous_;
 };
 
 /// Where the reading side stood after an item: what the backend side needs
@@ -86,6 +89,7 @@ class PipelineRun {
       : sequence_(sequence), options_(options), output_(output), progress_(progress) {}
 
   PipelineResult run() {
+    const OpenCvThreads opencv_threads(options_.frontend.threads);
     run_watch_.restart();
     run_start_cpu_s_ = Stopwatch::processCpuSeconds();
     setup();
@@ -143,6 +147,10 @@ class PipelineRun {
   BackendWork inline_work_;  // without a backend thread
   std::vector<Estimate> estimates_;
   std::vector<Estimate> checked_;
+  // stage_cpu_s: one split per thread (the reading thread's also takes the
+  // backend side without a backend thread).
+  StageCpuSplit reading_cpu_;
+  StageCpuSplit backend_thread_cpu_;
 
   // Loop state
   Stopwatch run_watch_;
@@ -266,7 +274,8 @@ void PipelineRun::setupStages() {
 
 void PipelineRun::runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs) {
   PipelineStageCpu& cpu = result_.cpu;
-  CpuLap lap;
+  StageCpuSplit& lap = reading_cpu_;
+  lap.begin();
   StageTimer timer(&result_.times.frontend_s);
   if (tracks_) {
     tracks_->process(item, backend_inputs);
@@ -304,7 +313,8 @@ void PipelineRun::takeSnapshot(ItemSnapshot& s) const {
 void PipelineRun::consume(BackendWork& work) {
   if (stopped_.load(std::memory_order_relaxed)) return;
   PipelineStageCpu& cpu = result_.cpu;
-  CpuLap lap;
+  StageCpuSplit& lap = options_.backend_thread ? backend_thread_cpu_ : reading_cpu_;
+  lap.begin();
   estimates_.clear();
   {
     StageTimer timer(&result_.times.backend_s);
@@ -344,11 +354,11 @@ void PipelineRun::afterItem(const ItemSnapshot& snapshot) {
 }
 
 void PipelineRun::writeTiming(TimeNs t_ns, std::uint64_t events_read) {
-  const double processing = elapsed();
   if (timing_started_ && !(t_ns > last_timing_t_ && nsToSeconds(t_ns - last_timing_t_) >= options_.output.timing_interval_s))
     return;
   const TimeNs t = timing_started_ ? t_ns : std::max(t_ns, *result_.initialization_t_ns);
   if (timing_started_ && t <= last_timing_t_) return;
+  const double processing = elapsed();  // read only when written: on the CPU clock it is a system call
   writer_->addTiming(io::TimingSample{t, processing, static_cast<std::int64_t>(events_read), trackedFeatures()});
   timing_started_ = true;
   last_timing_t_ = t;
@@ -368,11 +378,11 @@ void PipelineRun::loop() {
   while (!stopped_.load() && !(handoff && handoff->failed())) {
     {
       StageTimer timer(&result_.times.read_s);
-      CpuLap lap;
+      reading_cpu_.begin();
       const bool more = reader_->next(item);
       if (more && item.kind == SequenceItem::Kind::kFrame)
         item.image = reader_->loadFrame(item.frame_index, frame_size_, frame_size_from_);
-      lap.lap(&result_.cpu.read_s);
+      reading_cpu_.lap(&result_.cpu.read_s);
       if (!more) break;
     }
     if (!any_item_) {
@@ -395,6 +405,8 @@ void PipelineRun::loop() {
       consume(work);
   }
   if (handoff) handoff->finish();
+  reading_cpu_.flush();
+  backend_thread_cpu_.flushByWall();  // the backend thread has stopped
   // The run ends at the last item the backend side took (the same item
   // whether or not it ran on its own thread).
   result_.t_last_ns = last_consumed_.t_now;

@@ -82,9 +82,10 @@ struct PipelineStageTimes {
 };
 
 /// CPU seconds per stage (the CPU clock of the thread that ran the stage;
-/// tracking includes the tracker's worker threads), summed over the run;
-/// read once per stage and input item (a chunk of events, a frame, an IMU
-/// sample), never per event. The `eklt_*` entries split EKLT's tracking time as the tracker
+/// tracking includes the tracker's worker threads), summed over the run.
+/// Each thread's CPU clock is read once per 20 ms window and shared among
+/// the stages it ran in the window by their wall time (stage_cpu_split.h:
+/// exact per stage on an idle core), never per event. The `eklt_*` entries split EKLT's tracking time as the tracker
 /// itself measures it (wall seconds summed over its threads; 0 for the other
 /// trackers).
 struct PipelineStageCpu {

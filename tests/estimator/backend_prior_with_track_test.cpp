@@ -2,7 +2,9 @@
 // (BackendOptions::slam_prior_init_with_track; triangulation.h
 // refineWithDepthPrior, slam_features.h addSlamFeatureTriangulated with a
 // prior row): the MAP answer against its own cost, the two limits (no
-// parallax: the prior; no prior weight: the point), and the split.
+// parallax: the prior; no prior weight: the point), and the split; and the
+// iterated variant (slam_prior_track_iterated): the joint MAP of clones,
+// feature and prior, checked against that cost written out in the test.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -188,6 +190,90 @@ TEST(PriorWithTrack, BelowTheParallaxThresholdThePriorIsTakenAlone) {
   EXPECT_EQ(stats.slam_initialized_prior, 1);
   EXPECT_EQ(stats.slam_initialized_prior_track, 0);
   EXPECT_TRUE(clone_P.isApprox(1e-6 * MatX::Identity(24, 24), 1e-15));  // no update of the clones
+}
+
+/// The joint cost the iterated initialisation minimises, written out:
+/// ‖x ⊟ x0‖² in the metric of the prior covariance P0 (the state before the
+/// update, with the new feature at its plain prior) plus the track's earlier
+/// observations Σ_k ‖z_k − h(clone_k, f)‖² / σ_z².
+double jointCost(const FilterState& x, const FilterState& x0, const MatX& P0_inv, const std::vector<Vec2>& z,
+                 double sigma_z) {
+  const VecX d = x.minus(x0);
+  double cost = d.dot(P0_inv * d);
+  const std::size_t anchor = x.clones.size() - 1;
+  for (std::size_t k = 0; k + 1 < z.size(); ++k) {
+    Vec2 zh;
+    if (!projectAnchoredFeature(x.clones[anchor], x.clones[k], x.features[0].abr, &zh)) return 1e300;
+    cost += (z[k] - zh).squaredNorm() / (sigma_z * sigma_z);
+  }
+  return cost;
+}
+
+TEST(PriorWithTrack, TheIteratedInitialisationIsTheMapOfClonesFeatureAndPrior) {
+  // Six clones 2 cm apart with 1 cm of position uncertainty, a point 4 m
+  // away (ρ = 0.25), noisy observations, and the prior ρ0 = 1 (σ 0.5): the
+  // update moves clones and feature together to the least of the joint cost.
+  const std::vector<CameraClone> clones = clonesAlongX(6, 0.02);
+  FilterState s = stateOf(clones);
+  s.P = 1e-4 * MatX::Identity(s.dim(), s.dim());
+  Bench b(s);
+  b.options.slam_min_depth_m = 0.5;  // ρ0 = 1, σ 0.5
+  b.options.slam_triangulated_init = false;
+  b.options.slam_prior_init_with_track = true;
+  b.options.slam_prior_track_iterated = true;
+  b.options.slam_prior_track_iterations = 30;
+  b.options.observability_constraint = false;  // the plain MAP, no projected directions
+  const double sigma_z = 0.01;
+  SlamUpdater slam(b.context(), kCamera, sigma_z, &b.chi2, &b.chi2, nullptr);
+  const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0),
+                                      {Vec2(0.004, -0.002), Vec2(-0.003, 0.001), Vec2(0.0, 0.005)});
+  FeatureTrack t;
+  t.id = 3;
+  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i]});
+  // The prior: the state with the feature at its plain prior.
+  FilterState x0 = s;
+  addSlamFeatureWithPrior(x0, 3, clones.size() - 1, z.back(), 1.0, 0.5, sigma_z);
+  const MatX P0_inv = x0.P.inverse();
+  TrackMap tracks{{3, t}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  EXPECT_EQ(b.stats.slam_initialized_prior_track, 1);
+  ASSERT_EQ(b.state.features.size(), 1u);
+  const FilterState& x = b.state;
+  EXPECT_LT(x.features[0].abr.z(), 0.9);  // pulled from the prior towards 0.25
+  EXPECT_GT(x.clones[0].p_W_C.norm(), 1e-6);  // the clones moved too
+  const double best = jointCost(x, x0, P0_inv, z, sigma_z);
+  // No neighbour in any direction of the state costs less (relative step 1e-4 of each σ).
+  for (int i = 0; i < x.dim(); ++i) {
+    for (const double sign : {-1.0, 1.0}) {
+      FilterState y = x;
+      VecX dx = VecX::Zero(x.dim());
+      dx(i) = sign * 1e-4 * std::sqrt(x0.P(i, i));
+      y.correct(dx);
+      EXPECT_GE(jointCost(y, x0, P0_inv, z, sigma_z), best - 1e-9) << i << " " << sign;
+    }
+  }
+}
+
+TEST(PriorWithTrack, TheIteratedInitialisationFallsBackToThePlainPriorWhenTheTrackFailsTheGate) {
+  const std::vector<CameraClone> clones = clonesAlongX(5, 0.02);
+  Bench b(stateOf(clones));
+  b.options.slam_min_depth_m = 0.5;
+  b.options.slam_triangulated_init = false;
+  b.options.slam_prior_init_with_track = true;
+  b.options.slam_prior_track_iterated = true;
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2::Zero()});
+  z[1] += Vec2(0.2, 0.0);  // 20 σ off: an outlier
+  FeatureTrack t;
+  t.id = 3;
+  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i]});
+  TrackMap tracks{{3, t}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  EXPECT_EQ(b.stats.slam_initialized_prior_track, 0);
+  EXPECT_EQ(b.stats.slam_initialized_prior, 1);
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_DOUBLE_EQ(b.state.features[0].abr.z(), 1.0);
+  EXPECT_TRUE(b.state.P.block(15, 15, 30, 30).isApprox(1e-6 * MatX::Identity(30, 30), 1e-15));  // clones untouched
 }
 
 }  // namespace

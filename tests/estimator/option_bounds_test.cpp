@@ -35,6 +35,7 @@ const std::vector<Bound>& bounds() {
       {"backend.max_slam_features", "1000", "1000000"},
       {"backend.triangulation_max_iterations", "1000", "1000000000"},
       {"backend.iekf_iterations", "100", "1000000"},
+      {"backend.slam_prior_track_iterations", "50", "1000000"},
       {"backend.max_delay_s", "60", "1e9"},
       {"backend.static_window_s", "3600", "1e12"},
       {"frontend.eklt.max_features", "10000", "100000000"},

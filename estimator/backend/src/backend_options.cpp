@@ -38,6 +38,8 @@ void BackendOptions::validate() const {
   requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");
   requireInRange("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s, 0.0, 1e9);
   requireNonNegative("slam_prior_track_min_parallax_px", slam_prior_track_min_parallax_px);
+  requireField(slam_prior_track_iterations >= 1 && slam_prior_track_iterations <= 50, "slam_prior_track_iterations",
+               "must be in [1, 50]");
   requireField(slam_scene_depth_share >= 0.0 && slam_scene_depth_share < 1.0, "slam_scene_depth_share",
                "must be in [0, 1)");
   requireField(slam_scene_depth_memory_s > 0.0 && slam_scene_depth_memory_s <= 1e9, "slam_scene_depth_memory_s",

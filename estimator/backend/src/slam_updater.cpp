@@ -165,6 +165,7 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const Featu
   if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) <
                                 minParallaxNormalized(camera_, options().slam_prior_track_min_parallax_px))
     return PriorWithTrack::kNotUsed;
+  if (options().slam_prior_track_iterated) return initializeWithTrackIterated(track, prior, positions, z, whiten);
   const TriangulationOptions tri = triangulationOptions(sigma_z_, prior.sigma);
   Vec3 abr;
   if (!refineWithDepthPrior(clones, z, whiten, clones.size() - 1, prior.rho, prior.sigma, sigma_z_, tri, &abr))
@@ -175,6 +176,46 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const Featu
                                  [this](MatX* H) { constrain(H); }, &row);
   if (outcome == SlamInitOutcome::kUpdateFailed) return PriorWithTrack::kUpdateFailed;
   if (outcome != SlamInitOutcome::kOk) return PriorWithTrack::kNotUsed;
+  ++stats().slam_initialized_prior_track;
+  return PriorWithTrack::kDone;
+}
+
+SlamUpdater::PriorWithTrack SlamUpdater::initializeWithTrackIterated(const FeatureTrack& track,
+                                                                      const DepthPrior& prior,
+                                                                      const std::vector<std::size_t>& positions,
+                                                                      const std::vector<Vec2>& z,
+                                                                      const std::vector<Mat2>& whiten) {
+  // The plain prior at the last observation (its clone the anchor): (α, β)
+  // from that observation, ρ from the prior, on a copy of the state.
+  FilterState x = state();
+  addSlamFeatureWithPrior(x, track.id, positions.back(), z.back(), prior.rho, prior.sigma, sigma_z_, whiten.back());
+  // The earlier observations: whitened rows r_k = W_k (z_k − h(clone_k, f)),
+  // re-linearised at every iterate of clones and feature.
+  const std::size_t earlier = positions.size() - 1;
+  const auto rows = [&](const FilterState& at, MatX* H, VecX* r) {
+    H->setZero(2 * static_cast<Eigen::Index>(earlier), at.dim());
+    r->setZero(2 * static_cast<Eigen::Index>(earlier));
+    const int j = at.findFeature(track.id);
+    for (std::size_t k = 0; k < earlier && j >= 0; ++k) {
+      Eigen::Matrix<double, 2, Eigen::Dynamic> Hk;
+      Vec2 rk;
+      if (!slamResidual(at, static_cast<std::size_t>(j), positions[k], z[k], &Hk, &rk)) continue;  // zero rows
+      H->middleRows<2>(2 * static_cast<Eigen::Index>(k)) = whiten[k] * Hk;
+      r->segment<2>(2 * static_cast<Eigen::Index>(k)) = whiten[k] * rk;
+    }
+    constrainAt(at, H);
+  };
+  const double sigma2 = sigma_z_ * sigma_z_;
+  MatX H;
+  VecX r;
+  rows(x, &H, &r);
+  // The same χ² gate as the triangulated initialisation's remaining rows.
+  if (mahalanobisSquared(H, r, x.P, sigma2) > (*msckf_chi2_)(static_cast<int>(r.size())))
+    return PriorWithTrack::kNotUsed;
+  if (!iteratedEkfUpdate(x, rows, MatX(), VecX(), sigma2, options().slam_prior_track_iterations,
+                         options().joseph_form))
+    return PriorWithTrack::kUpdateFailed;
+  state() = std::move(x);
   ++stats().slam_initialized_prior_track;
   return PriorWithTrack::kDone;
 }

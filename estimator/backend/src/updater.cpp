@@ -6,9 +6,9 @@
 
 namespace evio::estimator {
 
-void Updater::constrain(MatX* H) const {
+void Updater::constrainAt(const FilterState& x, MatX* H) const {
   if (!options().observability_constraint || H->rows() == 0) return;
-  const VecX n = state().yawDirection(*ctx_.fej_imu);
+  const VecX n = x.yawDirection(*ctx_.fej_imu);
   *H -= (*H * n) * (n.transpose() / n.squaredNorm());
 }
 

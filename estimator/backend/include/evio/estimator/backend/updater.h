@@ -56,7 +56,10 @@ class Updater {
   /// The observability constraint (when enabled): H ← H (I − n nᵀ/‖n‖²), the
   /// smallest change of H with H n = 0, n the yaw direction
   /// (FilterState::yawDirection at the first estimate).
-  void constrain(MatX* H) const;
+  void constrain(MatX* H) const { constrainAt(state(), H); }
+  /// The same for rows whose columns are those of another state `x` (e.g. the
+  /// state with a feature about to be added): n is x's yaw direction.
+  void constrainAt(const FilterState& x, MatX* H) const;
 
  protected:
   /// The Mahalanobis test rᵀ (H P Hᵀ + σ² I)⁻¹ r ≤ threshold (a χ² quantile).

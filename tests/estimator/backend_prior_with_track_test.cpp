@@ -3,12 +3,15 @@
 // refineWithDepthPrior, slam_features.h addSlamFeatureTriangulated with a
 // prior row): the MAP answer against its own cost, the two limits (no
 // parallax: the prior; no prior weight: the point), and the split; and the
-// iterated variant (slam_prior_track_iterated): the joint MAP of clones,
-// feature and prior, checked against that cost written out in the test.
+// variant that takes the plain prior and then the track as an update
+// (slam_prior_track_update): one EKF update of the earlier observations, or
+// iterated, the joint MAP of clones, feature and prior, checked against that
+// cost written out in the test.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/slam_updater.h"
 #include "evio/estimator/backend/triangulation.h"
@@ -220,7 +223,7 @@ TEST(PriorWithTrack, TheIteratedInitialisationIsTheMapOfClonesFeatureAndPrior) {
   b.options.slam_min_depth_m = 0.5;  // ρ0 = 1, σ 0.5
   b.options.slam_triangulated_init = false;
   b.options.slam_prior_init_with_track = true;
-  b.options.slam_prior_track_iterated = true;
+  b.options.slam_prior_track_update = true;
   b.options.slam_prior_track_iterations = 30;
   b.options.observability_constraint = false;  // the plain MAP, no projected directions
   const double sigma_z = 0.01;
@@ -254,13 +257,52 @@ TEST(PriorWithTrack, TheIteratedInitialisationIsTheMapOfClonesFeatureAndPrior) {
   }
 }
 
+TEST(PriorWithTrack, OneIterationIsTheEkfUpdateOfTheEarlierObservationsAtThePlainPrior) {
+  const std::vector<CameraClone> clones = clonesAlongX(6, 0.02);
+  FilterState s = stateOf(clones);
+  s.P = 1e-4 * MatX::Identity(s.dim(), s.dim());
+  Bench b(s);
+  b.options.slam_min_depth_m = 0.5;  // ρ0 = 1, σ 0.5
+  b.options.slam_triangulated_init = false;
+  b.options.slam_prior_init_with_track = true;
+  b.options.slam_prior_track_update = true;
+  b.options.slam_prior_track_iterations = 1;
+  b.options.observability_constraint = false;
+  const double sigma_z = 0.01;
+  SlamUpdater slam(b.context(), kCamera, sigma_z, &b.chi2, &b.chi2, nullptr);
+  const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2(0.004, -0.002), Vec2(-0.003, 0.001)});
+  FeatureTrack t;
+  t.id = 3;
+  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i]});
+  // By hand: the plain prior at the last observation, then the rows of the
+  // five earlier observations stacked, one EKF update.
+  FilterState expected = s;
+  addSlamFeatureWithPrior(expected, 3, clones.size() - 1, z.back(), 1.0, 0.5, sigma_z);
+  MatX H = MatX::Zero(10, expected.dim());
+  VecX r(10);
+  for (std::size_t k = 0; k < 5; ++k) {
+    Eigen::Matrix<double, 2, Eigen::Dynamic> Hk;
+    Vec2 rk;
+    ASSERT_TRUE(slamResidual(expected, 0, k, z[k], &Hk, &rk));
+    H.middleRows<2>(2 * static_cast<Eigen::Index>(k)) = Hk;
+    r.segment<2>(2 * static_cast<Eigen::Index>(k)) = rk;
+  }
+  ASSERT_TRUE(ekfUpdate(expected, H, r, sigma_z * sigma_z, b.options.joseph_form));
+  TrackMap tracks{{3, t}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_LT((b.state.features[0].abr - expected.features[0].abr).norm(), 1e-12);
+  EXPECT_LT(b.state.minus(expected).norm(), 1e-12);
+  EXPECT_LT((b.state.P - expected.P).cwiseAbs().maxCoeff(), 1e-15);
+}
+
 TEST(PriorWithTrack, TheIteratedInitialisationFallsBackToThePlainPriorWhenTheTrackFailsTheGate) {
   const std::vector<CameraClone> clones = clonesAlongX(5, 0.02);
   Bench b(stateOf(clones));
   b.options.slam_min_depth_m = 0.5;
   b.options.slam_triangulated_init = false;
   b.options.slam_prior_init_with_track = true;
-  b.options.slam_prior_track_iterated = true;
+  b.options.slam_prior_track_update = true;
   SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
   std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2::Zero()});
   z[1] += Vec2(0.2, 0.0);  // 20 σ off: an outlier

@@ -165,7 +165,7 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const Featu
   if (clones.size() < 2 || rotationCompensatedDisparity(clones, z) <
                                 minParallaxNormalized(camera_, options().slam_prior_track_min_parallax_px))
     return PriorWithTrack::kNotUsed;
-  if (options().slam_prior_track_iterated) return initializeWithTrackIterated(track, prior, positions, z, whiten);
+  if (options().slam_prior_track_update) return initializeWithTrackUpdate(track, prior, positions, z, whiten);
   const TriangulationOptions tri = triangulationOptions(sigma_z_, prior.sigma);
   Vec3 abr;
   if (!refineWithDepthPrior(clones, z, whiten, clones.size() - 1, prior.rho, prior.sigma, sigma_z_, tri, &abr))
@@ -180,7 +180,7 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const Featu
   return PriorWithTrack::kDone;
 }
 
-SlamUpdater::PriorWithTrack SlamUpdater::initializeWithTrackIterated(const FeatureTrack& track,
+SlamUpdater::PriorWithTrack SlamUpdater::initializeWithTrackUpdate(const FeatureTrack& track,
                                                                       const DepthPrior& prior,
                                                                       const std::vector<std::size_t>& positions,
                                                                       const std::vector<Vec2>& z,

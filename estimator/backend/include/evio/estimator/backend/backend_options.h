@@ -91,16 +91,18 @@ struct BackendOptions {
   /// with the prior, px (below: the prior alone).
   double slam_prior_track_min_parallax_px = 0.0;
   /// With slam_prior_init_with_track: instead of the refinement with the
-  /// clones held at their estimates, the feature takes the plain prior at its
-  /// last observation and the track's earlier observations then enter an
-  /// iterated update that re-linearises clones and feature together: the
-  /// MAP of the window's poses, the feature and the prior, with the filter's
-  /// covariance as the poses' prior (a small bundle adjustment). The clones
-  /// move with the feature instead of being trusted.
-  bool slam_prior_track_iterated = false;
-  /// Gauss–Newton iterations of that update (it stops earlier once a step
-  /// changes the state by less than 1e-9).
-  int slam_prior_track_iterations = 5;
+  /// clones held at their estimates and the split, the feature takes the
+  /// plain prior at its last observation and the track's earlier
+  /// observations then enter as one update of clones and feature together.
+  /// With slam_prior_track_iterations > 1 the update is iterated
+  /// (re-linearised at each iterate): the MAP of the window's poses, the
+  /// feature and the prior, with the filter's covariance as the poses' prior
+  /// (a small bundle adjustment).
+  bool slam_prior_track_update = false;
+  /// Iterations of that update: 1 an EKF update linearised at the plain
+  /// prior; more, Gauss–Newton iterations (stopping once a step changes the
+  /// state by less than 1e-9).
+  int slam_prior_track_iterations = 1;
   /// Add the covariance of the bilinear ρ·(clone error) term that the EKF's
   /// linearisation drops to each SLAM observation's noise
   /// (slamSecondOrderCovariance in slam_features.h): the inflation is large
@@ -249,9 +251,9 @@ struct BackendOptions {
       "a depth-prior SLAM initialisation also uses the track's observations in the window");
     v("slam_prior_track_min_parallax_px", slam_prior_track_min_parallax_px,
       "rotation-compensated disparity a track needs to be taken with the depth prior, px");
-    v("slam_prior_track_iterated", slam_prior_track_iterated,
-      "the track taken with the prior by an iterated update of clones and feature together");
-    v("slam_prior_track_iterations", slam_prior_track_iterations, "iterations of that update");
+    v("slam_prior_track_update", slam_prior_track_update,
+      "the track's earlier observations enter as an update after the plain prior");
+    v("slam_prior_track_iterations", slam_prior_track_iterations, "iterations of that update (1: EKF)");
     v("slam_second_order_noise", slam_second_order_noise,
       "SLAM observation noise includes the second-order inverse-depth term");
     v("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s,

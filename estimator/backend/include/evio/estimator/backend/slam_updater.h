@@ -79,10 +79,11 @@ class SlamUpdater : public Updater {
   /// one observation, the refinement fails or the rest fails its gate.
   enum class PriorWithTrack { kDone, kNotUsed, kUpdateFailed };
   PriorWithTrack initializeWithPriorAndTrack(const FeatureTrack& track, const DepthPrior& prior);
-  /// slam_prior_track_iterated: the plain prior at the track's last
-  /// observation, then the earlier observations as an iterated update of
-  /// clones and feature together (χ²-gated first; kNotUsed when it fails).
-  PriorWithTrack initializeWithTrackIterated(const FeatureTrack& track, const DepthPrior& prior,
+  /// slam_prior_track_update: the plain prior at the track's last
+  /// observation, then the earlier observations as an update of clones and
+  /// feature together, iterated slam_prior_track_iterations times
+  /// (χ²-gated first; kNotUsed when it fails).
+  PriorWithTrack initializeWithTrackUpdate(const FeatureTrack& track, const DepthPrior& prior,
                                              const std::vector<std::size_t>& positions, const std::vector<Vec2>& z,
                                              const std::vector<Mat2>& whiten);
   /// The fixed prior through the scene depth ρ_s (added to the state at the

@@ -17,7 +17,15 @@ struct Bound {
   std::string key;      ///< dotted option path, as --set takes it
   std::string largest;  ///< the largest value that validates
   std::string absurd;   ///< a value far beyond it
+  std::vector<std::string> with = {};  ///< options the key needs ("key=value")
 };
+
+/// b.with plus key=value.
+std::vector<std::string> overridesOf(const Bound& b, const std::string& value) {
+  std::vector<std::string> o = b.with;
+  o.push_back(b.key + "=" + value);
+  return o;
+}
 
 /// The options of `method` with `overrides` ("key=value") applied as `--set` does; validated.
 PipelineOptions optionsWith(const std::string& method, const std::vector<std::string>& overrides) {
@@ -35,7 +43,8 @@ const std::vector<Bound>& bounds() {
       {"backend.max_slam_features", "1000", "1000000"},
       {"backend.triangulation_max_iterations", "1000", "1000000000"},
       {"backend.iekf_iterations", "100", "1000000"},
-      {"backend.slam_prior_track_iterations", "50", "1000000"},
+      {"backend.slam_prior_track_iterations", "50", "1000000",
+       {"backend.slam_prior_init_with_track=true", "backend.slam_prior_track_update=true"}},
       {"backend.max_delay_s", "60", "1e9"},
       {"backend.static_window_s", "3600", "1e12"},
       {"frontend.eklt.max_features", "10000", "100000000"},
@@ -64,7 +73,7 @@ const std::vector<Bound>& bounds() {
 TEST(OptionBounds, AbsurdValueIsOneErrorNamingTheField) {
   for (const Bound& b : bounds()) {
     try {
-      optionsWith("eklt-vio", {b.key + "=" + b.absurd});
+      optionsWith("eklt-vio", overridesOf(b, b.absurd));
       ADD_FAILURE() << b.key << "=" << b.absurd << " was accepted";
     } catch (const Error& e) {
       const std::string what = e.what();
@@ -75,7 +84,7 @@ TEST(OptionBounds, AbsurdValueIsOneErrorNamingTheField) {
 }
 
 TEST(OptionBounds, LargestAllowedValueValidates) {
-  for (const Bound& b : bounds()) EXPECT_NO_THROW(optionsWith("eklt-vio", {b.key + "=" + b.largest})) << b.key;
+  for (const Bound& b : bounds()) EXPECT_NO_THROW(optionsWith("eklt-vio", overridesOf(b, b.largest))) << b.key;
 }
 
 TEST(OptionBounds, CalibrationSensorSizeBounded) {

@@ -40,6 +40,10 @@ void BackendOptions::validate() const {
   requireNonNegative("slam_prior_track_min_parallax_px", slam_prior_track_min_parallax_px);
   requireField(slam_prior_track_iterations >= 1 && slam_prior_track_iterations <= 50, "slam_prior_track_iterations",
                "must be in [1, 50]");
+  requireField(!slam_prior_track_update || slam_prior_init_with_track, "slam_prior_track_update",
+               "needs slam_prior_init_with_track: true");
+  requireField(slam_prior_track_iterations == 1 || slam_prior_track_update, "slam_prior_track_iterations",
+               "above 1 needs slam_prior_track_update: true");
   requireField(slam_scene_depth_share >= 0.0 && slam_scene_depth_share < 1.0, "slam_scene_depth_share",
                "must be in [0, 1)");
   requireField(slam_scene_depth_memory_s > 0.0 && slam_scene_depth_memory_s <= 1e9, "slam_scene_depth_memory_s",

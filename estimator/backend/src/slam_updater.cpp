@@ -181,25 +181,31 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithPriorAndTrack(const Featu
 }
 
 SlamUpdater::PriorWithTrack SlamUpdater::initializeWithTrackUpdate(const FeatureTrack& track,
-                                                                      const DepthPrior& prior,
-                                                                      const std::vector<std::size_t>& positions,
-                                                                      const std::vector<Vec2>& z,
-                                                                      const std::vector<Mat2>& whiten) {
+                                                                    const DepthPrior& prior,
+                                                                    const std::vector<std::size_t>& positions,
+                                                                    const std::vector<Vec2>& z,
+                                                                    const std::vector<Mat2>& whiten) {
   // The plain prior at the last observation (its clone the anchor): (α, β)
   // from that observation, ρ from the prior, on a copy of the state.
   FilterState x = state();
   addSlamFeatureWithPrior(x, track.id, positions.back(), z.back(), prior.rho, prior.sigma, sigma_z_, whiten.back());
   // The earlier observations: whitened rows r_k = W_k (z_k − h(clone_k, f)),
-  // re-linearised at every iterate of clones and feature.
+  // re-linearised at every iterate of clones and feature. An observation
+  // that cannot be predicted (the point behind its clone) at any iterate
+  // leaves the plain prior alone.
   const std::size_t earlier = positions.size() - 1;
+  bool all_rows = true;
   const auto rows = [&](const FilterState& at, MatX* H, VecX* r) {
     H->setZero(2 * static_cast<Eigen::Index>(earlier), at.dim());
     r->setZero(2 * static_cast<Eigen::Index>(earlier));
     const int j = at.findFeature(track.id);
-    for (std::size_t k = 0; k < earlier && j >= 0; ++k) {
+    for (std::size_t k = 0; k < earlier; ++k) {
       Eigen::Matrix<double, 2, Eigen::Dynamic> Hk;
       Vec2 rk;
-      if (!slamResidual(at, static_cast<std::size_t>(j), positions[k], z[k], &Hk, &rk)) continue;  // zero rows
+      if (j < 0 || !slamResidual(at, static_cast<std::size_t>(j), positions[k], z[k], &Hk, &rk)) {
+        all_rows = false;
+        continue;
+      }
       H->middleRows<2>(2 * static_cast<Eigen::Index>(k)) = whiten[k] * Hk;
       r->segment<2>(2 * static_cast<Eigen::Index>(k)) = whiten[k] * rk;
     }
@@ -210,11 +216,18 @@ SlamUpdater::PriorWithTrack SlamUpdater::initializeWithTrackUpdate(const Feature
   VecX r;
   rows(x, &H, &r);
   // The same χ² gate as the triangulated initialisation's remaining rows.
-  if (mahalanobisSquared(H, r, x.P, sigma2) > (*msckf_chi2_)(static_cast<int>(r.size())))
+  if (!all_rows || mahalanobisSquared(H, r, x.P, sigma2) > (*msckf_chi2_)(static_cast<int>(r.size())))
     return PriorWithTrack::kNotUsed;
+  // Only the copy is touched: a failed update, a lost row or a point ending
+  // behind its anchor leave the plain prior.
   if (!iteratedEkfUpdate(x, rows, MatX(), VecX(), sigma2, options().slam_prior_track_iterations,
-                         options().joseph_form))
-    return PriorWithTrack::kUpdateFailed;
+                         options().joseph_form) ||
+      !all_rows)
+    return PriorWithTrack::kNotUsed;
+  const int j = x.findFeature(track.id);
+  if (j < 0 || !x.features[static_cast<std::size_t>(j)].abr.allFinite() ||
+      !(x.features[static_cast<std::size_t>(j)].abr.z() > 0.0))
+    return PriorWithTrack::kNotUsed;
   state() = std::move(x);
   ++stats().slam_initialized_prior_track;
   return PriorWithTrack::kDone;

@@ -45,8 +45,10 @@ void WorkerPool::runParts(PartFn fn, void* context) {
   runPart(0);
   const double part0_cpu = Stopwatch::threadCpuSeconds() - cpu0;
   {
+    const Stopwatch waiting;
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [this] { return pending_ == 0; });
+    cpu_.wait_s += waiting.seconds();
     part_cpu_s_[0] = part0_cpu;
     double slowest = 0.0;
     for (double c : part_cpu_s_) {

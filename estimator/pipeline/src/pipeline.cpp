@@ -46,10 +46,12 @@ class StageTimer {
   Stopwatch watch_;
 };
 
-/// OpenCV's parallel loops (the frames' pyramids and filters) on at most
-/// `threads` threads while it lives; with one, on the calling thread alone
-/// (else an idle OpenCV worker spins between frames: 44 000 sched_yield
-/// calls in a 12 s EKLT-VIO run). Their results do not depend on it.
+/// OpenCV's parallel loops (the frames' pyramids and filters, KLT) on at
+/// most `threads` threads while it lives; with one, on the calling thread
+/// alone (else an idle OpenCV worker spins between frames: 32 017
+/// sched_yield calls in a 12 s EKLT-VIO run). Their results do not depend on
+/// it. OpenCV's thread count is process-wide: runs in one process must not
+/// overlap (runPipeline's contract, pipeline.h).
 class OpenCvThreads {
  public:
   explicit OpenCvThreads(int threads) : previous_(cv::getNumThreads()) { cv::setNumThreads(threads > 1 ? threads : 0); }
@@ -89,10 +91,10 @@ class PipelineRun {
       : sequence_(sequence), options_(options), output_(output), progress_(progress) {}
 
   PipelineResult run() {
-    const OpenCvThreads opencv_threads(options_.frontend.threads);
     run_watch_.restart();
     run_start_cpu_s_ = Stopwatch::processCpuSeconds();
     setup();
+    const OpenCvThreads opencv_threads(options_.frontend.threads);  // validated by setup()
     loop();
     finish();
     return result_;
@@ -274,22 +276,24 @@ void PipelineRun::setupStages() {
 
 void PipelineRun::runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs) {
   PipelineStageCpu& cpu = result_.cpu;
-  StageCpuSplit& lap = reading_cpu_;
-  lap.begin();
+  StageCpuSplit& split = reading_cpu_;
+  split.begin();
   StageTimer timer(&result_.times.frontend_s);
   if (tracks_) {
     tracks_->process(item, backend_inputs);
-    lap.lap(&cpu.sync_s);
+    split.lap(&cpu.sync_s);
     return;
   }
   filtered_.clear();
   tracked_.clear();
   prefilter_->process(item, filtered_);
-  lap.lap(&cpu.prefilter_s);
+  split.lap(&cpu.prefilter_s);
+  // The tracker's wait for its worker threads uses no CPU of this thread.
+  const double waited0 = frontend_->trackerParallelCpu().wait_s;
   for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
-  lap.lap(&cpu.tracking_s);
+  split.lap(&cpu.tracking_s, frontend_->trackerParallelCpu().wait_s - waited0);
   for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs);
-  lap.lap(&cpu.sync_s);
+  split.lap(&cpu.sync_s);
   if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
 }
 
@@ -313,14 +317,14 @@ void PipelineRun::takeSnapshot(ItemSnapshot& s) const {
 void PipelineRun::consume(BackendWork& work) {
   if (stopped_.load(std::memory_order_relaxed)) return;
   PipelineStageCpu& cpu = result_.cpu;
-  StageCpuSplit& lap = options_.backend_thread ? backend_thread_cpu_ : reading_cpu_;
-  lap.begin();
+  StageCpuSplit& split = options_.backend_thread ? backend_thread_cpu_ : reading_cpu_;
+  split.begin();
   estimates_.clear();
   {
     StageTimer timer(&result_.times.backend_s);
     for (BackendInput& in : work.inputs) backend_stage_->process(in, estimates_);
   }
-  lap.lap(&cpu.backend_s);
+  split.lap(&cpu.backend_s);
   checked_.clear();
   for (Estimate& e : estimates_) health_->process(e, checked_);
   {
@@ -328,7 +332,7 @@ void PipelineRun::consume(BackendWork& work) {
     for (const Estimate& e : checked_) writer_->addEstimate(e);
   }
   afterItem(work.snapshot);
-  lap.lap(&cpu.output_s);
+  split.lap(&cpu.output_s);
   last_consumed_ = work.snapshot;
   const bool stop = !backend_->status().ok() || pipeline_failure_.has_value();
   if (stop && options_.output.stop_on_divergence) stopped_.store(true);

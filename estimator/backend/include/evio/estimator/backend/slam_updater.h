@@ -74,15 +74,17 @@ class SlamUpdater : public Updater {
   void initializeWithPrior(const FeatureTrack& track, std::size_t c, const DepthPrior& prior);
   /// With slam_prior_init_with_track: the track's observations in the window
   /// and the depth prior together (refineWithDepthPrior, then the split of
-  /// addSlamFeatureTriangulated with the prior as one more row). kNotUsed
-  /// (the caller takes the plain prior) when the option is off, the track has
-  /// one observation, the refinement fails or the rest fails its gate.
+  /// addSlamFeatureTriangulated with the prior as one more row), or with
+  /// slam_prior_track_update initializeWithTrackUpdate. kNotUsed (the caller
+  /// takes the plain prior) when the option is off, the track has one
+  /// observation, the refinement fails or the rest fails its gate.
   enum class PriorWithTrack { kDone, kNotUsed, kUpdateFailed };
   PriorWithTrack initializeWithPriorAndTrack(const FeatureTrack& track, const DepthPrior& prior);
   /// slam_prior_track_update: the plain prior at the track's last
   /// observation, then the earlier observations as an update of clones and
-  /// feature together, iterated slam_prior_track_iterations times
-  /// (χ²-gated first; kNotUsed when it fails).
+  /// feature together, iterated slam_prior_track_iterations times, on a
+  /// copy of the state (χ²-gated first; never kUpdateFailed: any failure,
+  /// including an observation that cannot be predicted, is kNotUsed).
   PriorWithTrack initializeWithTrackUpdate(const FeatureTrack& track, const DepthPrior& prior,
                                              const std::vector<std::size_t>& positions, const std::vector<Vec2>& z,
                                              const std::vector<Mat2>& whiten);

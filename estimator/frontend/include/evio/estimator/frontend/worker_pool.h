@@ -39,6 +39,9 @@ class WorkerPool {
     double workers_s = 0.0;
     double parts_s = 0.0;
     double critical_path_s = 0.0;
+    /// Wall seconds the calling thread waited for the workers after its own
+    /// part (it uses no CPU then; the pipeline's stage split leaves it out).
+    double wait_s = 0.0;
   };
   Cpu cpu() const {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -84,8 +84,9 @@ struct PipelineStageTimes {
 /// CPU seconds per stage (the CPU clock of the thread that ran the stage;
 /// tracking includes the tracker's worker threads), summed over the run.
 /// Each thread's CPU clock is read once per 20 ms window and shared among
-/// the stages it ran in the window by their wall time (stage_cpu_split.h:
-/// exact per stage on an idle core), never per event. The `eklt_*` entries split EKLT's tracking time as the tracker
+/// the stages it ran in the window by their busy wall time (the tracker's
+/// wait for its workers left out; stage_cpu_split.h: exact per stage on an
+/// idle core), never per event. The `eklt_*` entries split EKLT's tracking time as the tracker
 /// itself measures it (wall seconds summed over its threads; 0 for the other
 /// trackers).
 struct PipelineStageCpu {
@@ -184,7 +185,9 @@ struct PipelineResult {
 /// Runs `options.method` over `sequence` and writes the estimate folder
 /// `output` (created when missing). Throws evio::Error for bad input (see
 /// the file comment); filter divergence and failure are in the result and
-/// status.yaml instead.
+/// status.yaml instead. For the run, OpenCV's (process-wide) thread count is
+/// set to frontend.threads (0, the calling thread alone, for one) and then
+/// restored: runs in one process must not overlap.
 PipelineResult runPipeline(const std::string& sequence, const PipelineOptions& options, const std::string& output,
                            const PipelineProgressCallback& progress = {});
 

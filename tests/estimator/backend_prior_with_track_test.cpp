@@ -195,6 +195,25 @@ TEST(PriorWithTrack, BelowTheParallaxThresholdThePriorIsTakenAlone) {
   EXPECT_TRUE(clone_P.isApprox(1e-6 * MatX::Identity(24, 24), 1e-15));  // no update of the clones
 }
 
+/// Options for the track as an update after the plain prior: ρ0 = 1 (σ 0.5)
+/// from d_min = 0.5 m, no triangulated initialisation.
+void useTrackUpdate(BackendOptions* o, int iterations) {
+  o->slam_min_depth_m = 0.5;
+  o->slam_triangulated_init = false;
+  o->slam_prior_init_with_track = true;
+  o->slam_prior_track_update = true;
+  o->slam_prior_track_iterations = iterations;
+}
+
+/// Track `id` observed at z[i] from clones[i], whitened by W.
+FeatureTrack trackOf(FeatureId id, const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
+                     const Mat2& W = Mat2::Identity()) {
+  FeatureTrack t;
+  t.id = id;
+  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i], W});
+  return t;
+}
+
 /// The joint cost the iterated initialisation minimises, written out:
 /// ‖x ⊟ x0‖² in the metric of the prior covariance P0 (the state before the
 /// update, with the new feature at its plain prior) plus the track's earlier
@@ -220,19 +239,13 @@ TEST(PriorWithTrack, TheIteratedUpdateIsTheMapOfClonesFeatureAndPrior) {
   FilterState s = stateOf(clones);
   s.P = 1e-4 * MatX::Identity(s.dim(), s.dim());
   Bench b(s);
-  b.options.slam_min_depth_m = 0.5;  // ρ0 = 1, σ 0.5
-  b.options.slam_triangulated_init = false;
-  b.options.slam_prior_init_with_track = true;
-  b.options.slam_prior_track_update = true;
-  b.options.slam_prior_track_iterations = 30;
+  useTrackUpdate(&b.options, 30);
   b.options.observability_constraint = false;  // the plain MAP, no projected directions
   const double sigma_z = 0.01;
   SlamUpdater slam(b.context(), kCamera, sigma_z, &b.chi2, &b.chi2, nullptr);
   const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0),
                                       {Vec2(0.004, -0.002), Vec2(-0.003, 0.001), Vec2(0.0, 0.005)});
-  FeatureTrack t;
-  t.id = 3;
-  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i]});
+  const FeatureTrack t = trackOf(3, clones, z);
   // The prior: the state with the feature at its plain prior.
   FilterState x0 = s;
   addSlamFeatureWithPrior(x0, 3, clones.size() - 1, z.back(), 1.0, 0.5, sigma_z);
@@ -263,20 +276,14 @@ TEST(PriorWithTrack, OneIterationIsTheEkfUpdateOfTheEarlierObservationsAtThePlai
     FilterState s = stateOf(clones);
     s.P = 1e-4 * MatX::Identity(s.dim(), s.dim());
     Bench b(s);
-    b.options.slam_min_depth_m = 0.5;  // ρ0 = 1, σ 0.5
-    b.options.slam_triangulated_init = false;
-    b.options.slam_prior_init_with_track = true;
-    b.options.slam_prior_track_update = true;
-    b.options.slam_prior_track_iterations = 1;
+    useTrackUpdate(&b.options, 1);
     b.options.observability_constraint = constrained;
     const double sigma_z = 0.01;
     SlamUpdater slam(b.context(), kCamera, sigma_z, &b.chi2, &b.chi2, nullptr);
     const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2(0.004, -0.002), Vec2(-0.003, 0.001)});
     // Whitening that is not the identity (EKLT's per-point covariance).
     const Mat2 W = (Mat2() << 1.2, 0.3, 0.0, 0.8).finished();
-    FeatureTrack t;
-    t.id = 3;
-    for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i], W});
+    const FeatureTrack t = trackOf(3, clones, z, W);
     // By hand: the plain prior at the last observation, then the whitened
     // rows of the five earlier observations stacked (projected off the yaw
     // direction n when constrained), one EKF update.
@@ -310,15 +317,9 @@ TEST(PriorWithTrack, TheUpdateLeavesThePlainPriorWhenAnEarlierObservationCannotB
   const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2::Zero()});
   clones[1].q_W_C = clones[1].q_fej = Quat(Eigen::AngleAxisd(M_PI, Vec3::UnitY()));  // looks away: the point is behind it
   Bench b(stateOf(clones));
-  b.options.slam_min_depth_m = 0.5;
-  b.options.slam_triangulated_init = false;
-  b.options.slam_prior_init_with_track = true;
-  b.options.slam_prior_track_update = true;
+  useTrackUpdate(&b.options, 1);
   SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
-  FeatureTrack t;
-  t.id = 3;
-  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i]});
-  TrackMap tracks{{3, t}};
+  TrackMap tracks{{3, trackOf(3, clones, z)}};
   ASSERT_TRUE(slam.initialize({3}, &tracks));
   EXPECT_EQ(b.stats.slam_initialized_prior_track, 0);
   EXPECT_EQ(b.stats.slam_initialized_prior, 1);
@@ -329,17 +330,11 @@ TEST(PriorWithTrack, TheUpdateLeavesThePlainPriorWhenAnEarlierObservationCannotB
 TEST(PriorWithTrack, TheUpdateLeavesThePlainPriorWhenTheTrackFailsTheGate) {
   const std::vector<CameraClone> clones = clonesAlongX(5, 0.02);
   Bench b(stateOf(clones));
-  b.options.slam_min_depth_m = 0.5;
-  b.options.slam_triangulated_init = false;
-  b.options.slam_prior_init_with_track = true;
-  b.options.slam_prior_track_update = true;
+  useTrackUpdate(&b.options, 1);
   SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
   std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2::Zero()});
   z[1] += Vec2(0.2, 0.0);  // 20 σ off: an outlier
-  FeatureTrack t;
-  t.id = 3;
-  for (std::size_t i = 0; i < z.size(); ++i) t.observations.push_back({clones[i].id, z[i]});
-  TrackMap tracks{{3, t}};
+  TrackMap tracks{{3, trackOf(3, clones, z)}};
   ASSERT_TRUE(slam.initialize({3}, &tracks));
   EXPECT_EQ(b.stats.slam_initialized_prior_track, 0);
   EXPECT_EQ(b.stats.slam_initialized_prior, 1);

@@ -312,35 +312,34 @@ TEST(PriorWithTrack, OneIterationIsTheEkfUpdateOfTheEarlierObservationsAtThePlai
   }
 }
 
+/// Initialises track 3 (observations z from `clones`, P = 1e-6 I) with the
+/// track update and expects the plain prior alone: ρ = ρ0, the clones untouched.
+void expectThePlainPriorAlone(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z) {
+  Bench b(stateOf(clones));
+  useTrackUpdate(&b.options, 1);
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  TrackMap tracks{{3, trackOf(3, clones, z)}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  EXPECT_EQ(b.stats.slam_initialized_prior_track, 0);
+  EXPECT_EQ(b.stats.slam_initialized_prior, 1);
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_DOUBLE_EQ(b.state.features[0].abr.z(), 1.0);
+  const int n = 6 * static_cast<int>(clones.size());
+  EXPECT_TRUE(b.state.P.block(15, 15, n, n).isApprox(1e-6 * MatX::Identity(n, n), 1e-15));
+}
+
 TEST(PriorWithTrack, TheUpdateLeavesThePlainPriorWhenAnEarlierObservationCannotBePredicted) {
   std::vector<CameraClone> clones = clonesAlongX(5, 0.02);
   const std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2::Zero()});
   clones[1].q_W_C = clones[1].q_fej = Quat(Eigen::AngleAxisd(M_PI, Vec3::UnitY()));  // looks away: the point is behind it
-  Bench b(stateOf(clones));
-  useTrackUpdate(&b.options, 1);
-  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
-  TrackMap tracks{{3, trackOf(3, clones, z)}};
-  ASSERT_TRUE(slam.initialize({3}, &tracks));
-  EXPECT_EQ(b.stats.slam_initialized_prior_track, 0);
-  EXPECT_EQ(b.stats.slam_initialized_prior, 1);
-  ASSERT_EQ(b.state.features.size(), 1u);
-  EXPECT_DOUBLE_EQ(b.state.features[0].abr.z(), 1.0);
+  expectThePlainPriorAlone(clones, z);
 }
 
 TEST(PriorWithTrack, TheUpdateLeavesThePlainPriorWhenTheTrackFailsTheGate) {
   const std::vector<CameraClone> clones = clonesAlongX(5, 0.02);
-  Bench b(stateOf(clones));
-  useTrackUpdate(&b.options, 1);
-  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
   std::vector<Vec2> z = observe(clones, Vec3(0.3, -0.2, 4.0), {Vec2::Zero()});
   z[1] += Vec2(0.2, 0.0);  // 20 σ off: an outlier
-  TrackMap tracks{{3, trackOf(3, clones, z)}};
-  ASSERT_TRUE(slam.initialize({3}, &tracks));
-  EXPECT_EQ(b.stats.slam_initialized_prior_track, 0);
-  EXPECT_EQ(b.stats.slam_initialized_prior, 1);
-  ASSERT_EQ(b.state.features.size(), 1u);
-  EXPECT_DOUBLE_EQ(b.state.features[0].abr.z(), 1.0);
-  EXPECT_TRUE(b.state.P.block(15, 15, 30, 30).isApprox(1e-6 * MatX::Identity(30, 30), 1e-15));  // clones untouched
+  expectThePlainPriorAlone(clones, z);
 }
 
 }  // namespace

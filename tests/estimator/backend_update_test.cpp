@@ -287,6 +287,9 @@ TEST(BackendEkfUpdate, QrCompressionAndJosephFormGiveTheSameUpdate) {
   }
   EXPECT_LT((a.P - a.P.transpose()).norm(), 1e-18);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(a.P).eigenvalues().minCoeff(), 0.0);
+  // The default update P − K S Kᵀ (no Joseph form) is symmetric and positive definite too.
+  EXPECT_LT((c.P - c.P.transpose()).norm(), 1e-18);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(c.P).eigenvalues().minCoeff(), 0.0);
   EXPECT_DOUBLE_EQ(mahalanobisSquared(MatX::Identity(1, n), VecX::Zero(1), s0.P, 1.0), 0.0);
 }
 

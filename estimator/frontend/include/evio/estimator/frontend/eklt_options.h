@@ -62,9 +62,8 @@ struct EkltOptions {
   /// ReversingMotionIsFollowed). The re-solve starts where ρ < 0 and
   /// nearly always runs to max_iterations; below quality 0.7 it wins 12–41 %
   /// of the time, between 0.7 and 0.8 only 5–6 % (poster_6dof). 0.7 against
-  /// the former 0.8: 22 % fewer solver iterations on paper_table and
-  /// mars_yard_circle, every cell's median error within its quartiles
-  /// (README "Real time").
+  /// the former 0.8: 11–30 % fewer solver iterations per campaign cell, every
+  /// cell's median error within its former quartiles (README "Real time").
   double reversal_quality = 0.7;
   /// A batch holds the events of about batch_displacement_px of motion, so a
   /// solution that moves the feature further than this from its prediction

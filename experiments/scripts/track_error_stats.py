@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""Statistics of feature-track errors against their truth: how large, how
+they grow with the track's age, and how long they stay correlated.
+
+Input: a tracks file (`evio track`, id t x y, pixels) and the true positions
+of the same tracks (`evio evaluate-tracks ... --truth-output`, id t x y, the
+truth of each point until its truth ends). Each track's error is
+e(t) = tracked − true, px. Printed:
+
+  * points, RMS error per axis, median |e|;
+  * RMS |e| per age bin (time since the track's first point);
+  * the normalised error correlation at lags L:
+      c(L) = Σ e(t)·e(t+L) / sqrt(Σ |e(t)|² Σ |e(t+L)|²)
+    over all tracks and points whose track still has a point at t + L
+    (e(t+L) linearly interpolated between the track's points);
+  * the same for the error's change since the track's first point,
+    e(t) − e(t0), which is what a filter that took the first point as the
+    feature's bearing sees.
+
+Points whose error exceeds --max-error (px) are left out of every figure
+but the first line: gross losses, which the filter's gate rejects, would
+otherwise set the RMS and the correlations. The drift rate q (px² per s, per
+axis) is the least-squares slope of the robust per-axis variance
+(1.4826 · MAD)² against the age bins' mean age, with its intercept the
+variance at the track's start.
+
+Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8] [--max-error 5]
+"""
+import argparse
+import sys
+
+import numpy as np
+
+
+def read_points(path):
+    """{id: (t[], xy[n,2])} from an `id t x y` file (comments '#')."""
+    rows = np.loadtxt(path, comments="#", ndmin=2)
+    tracks = {}
+    for fid in np.unique(rows[:, 0]).astype(int):
+        r = rows[rows[:, 0] == fid]
+        order = np.argsort(r[:, 1], kind="stable")
+        tracks[fid] = (r[order, 1], r[order, 2:4])
+    return tracks
+
+
+def errors(tracks, truth, skip_s):
+    """{id: (t[], e[n,2], age[n])}: tracked − true at the truth's times."""
+    out = {}
+    for fid, (tt, xy_true) in truth.items():
+        if fid not in tracks:
+            continue
+        t, xy = tracks[fid]
+        keep = np.isin(t, tt)
+        t_k, xy_k = t[keep], xy[keep]
+        truth_at = {ti: xi for ti, xi in zip(tt, xy_true)}
+        e = np.array([xy_k[i] - truth_at[ti] for i, ti in enumerate(t_k)]).reshape(-1, 2)
+        if len(t_k) < 2:
+            continue
+        sel = t_k >= skip_s
+        out[fid] = (t_k[sel], e[sel], (t_k - t_k[0])[sel])
+    return out
+
+
+def correlation(errs, lag, since_start):
+    num, a2, b2, n = 0.0, 0.0, 0.0, 0
+    for t, e, _ in errs.values():
+        if len(t) < 2:
+            continue
+        ee = e - e[0] if since_start else e
+        later = t + lag
+        ok = later <= t[-1]
+        if not ok.any():
+            continue
+        ex = np.interp(later[ok], t, ee[:, 0])
+        ey = np.interp(later[ok], t, ee[:, 1])
+        num += float(np.sum(ee[ok, 0] * ex + ee[ok, 1] * ey))
+        a2 += float(np.sum(ee[ok] ** 2))
+        b2 += float(np.sum(ex ** 2 + ey ** 2))
+        n += int(ok.sum())
+    return (num / np.sqrt(a2 * b2) if a2 > 0 and b2 > 0 else float("nan")), n
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("tracks")
+    ap.add_argument("truth")
+    ap.add_argument("--lags", default="0.01,0.04,0.1,0.2,0.4,0.8,1.6")
+    ap.add_argument("--age-bins", default="0,0.1,0.2,0.4,0.8,1.6,3.2,100")
+    ap.add_argument("--skip-s", type=float, default=0.0, help="ignore points before this time, s")
+    ap.add_argument("--max-error", type=float, default=5.0, help="leave out points with |e| above this, px")
+    a = ap.parse_args()
+    errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
+    if not errs:
+        sys.exit("no track has a truth")
+    n_all = sum(len(v[0]) for v in errs.values())
+    for fid, (t, e, age) in list(errs.items()):
+        keep = np.linalg.norm(e, axis=1) <= a.max_error
+        errs[fid] = (t[keep], e[keep], age[keep])
+    e = np.concatenate([v[1] for v in errs.values()])
+    age = np.concatenate([v[2] for v in errs.values()])
+    print(f"tracks {len(errs)}  points {n_all}, {len(e)} with |e| <= {a.max_error} px")
+    print(f"RMS error x {np.sqrt(np.mean(e[:, 0] ** 2)):.3f} px  y {np.sqrt(np.mean(e[:, 1] ** 2)):.3f} px  "
+          f"median |e| {np.median(np.linalg.norm(e, axis=1)):.3f} px")
+    edges = [float(x) for x in a.age_bins.split(",")]
+    print("age bin (s)      points  RMS |e| (px)  median |e| (px)  robust var x, y (px²)")
+    mean_age, var, weight = [], [], []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        m = (age >= lo) & (age < hi)
+        if m.sum() >= 20:
+            norm = np.linalg.norm(e[m], axis=1)
+            mad = 1.4826 * np.median(np.abs(e[m] - np.median(e[m], axis=0)), axis=0)
+            print(f"[{lo:5.2f}, {hi:6.2f})  {int(m.sum()):8d}  {np.sqrt(np.mean(norm ** 2)):12.3f}  "
+                  f"{np.median(norm):15.3f}  {mad[0] ** 2:8.3f} {mad[1] ** 2:8.3f}")
+            mean_age.append(float(np.mean(age[m])))
+            var.append(float(np.mean(mad ** 2)))
+            weight.append(float(m.sum()))
+    if len(var) >= 2:
+        w = np.sqrt(np.array(weight))
+        A = np.stack([np.ones(len(var)), np.array(mean_age)], axis=1)
+        (v0, q), *_ = np.linalg.lstsq(A * w[:, None], np.array(var) * w, rcond=None)
+        print(f"per-axis variance ≈ {v0:.3f} px² + {q:.3f} px²/s · age")
+    print("lag (s)  corr e(t)   pairs    corr e(t)-e(t0)")
+    for lag in (float(x) for x in a.lags.split(",")):
+        c, n = correlation(errs, lag, False)
+        c0, _ = correlation(errs, lag, True)
+        print(f"{lag:7.3f}  {c:9.3f}  {n:8d}  {c0:9.3f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -3,28 +3,38 @@
 they grow with the track's age, and how long they stay correlated.
 
 Input: a tracks file (`evio track`, id t x y, pixels) and the true positions
-of the same tracks (`evio evaluate-tracks ... --truth-output`, id t x y, the
-truth of each point until its truth ends). Each track's error is
-e(t) = tracked − true, px. Printed:
+of the same tracks written by `evio evaluate-tracks ... --truth-output` from
+that file (id t x y, the truth of each point until its truth ends). A track
+point is paired with the truth point of the same id and the same time
+stamp, which holds because the truth file copies the tracks' stamps; points
+without one are skipped. Each track's error is e(t) = tracked − true, px, and
+its age the time since the track's first point with a truth. Printed:
 
   * points, RMS error per axis, median |e|;
-  * RMS |e| per age bin (time since the track's first point);
-  * the normalised error correlation at lags L:
+  * per age bin: RMS |e|, median |e| and the robust per-axis variance
+    (1.4826 · median absolute deviation)²;
+  * the drift rate q (px² per s, per axis): the least-squares slope of the
+    robust variance (mean of the two axes) against the bins' mean age,
+    weighted by the square root of each bin's point count, with its
+    intercept the variance at the start;
+  * the normalised error correlation at lags L, not mean-removed (a bias
+    shared by every point counts as correlation):
       c(L) = Σ e(t)·e(t+L) / sqrt(Σ |e(t)|² Σ |e(t+L)|²)
     over all tracks and points whose track still has a point at t + L
-    (e(t+L) linearly interpolated between the track's points);
-  * the same for the error's change since the track's first point,
+    (e(t+L) linearly interpolated between the track's points; at lags
+    shorter than the track's point spacing c(L) mostly compares a point with
+    itself);
+  * the same for the error's change since the track's first kept point,
     e(t) − e(t0), which is what a filter that took the first point as the
     feature's bearing sees.
 
 Points whose error exceeds --max-error (px) are left out of every figure
-but the first line: gross losses, which the filter's gate rejects, would
-otherwise set the RMS and the correlations. The drift rate q (px² per s, per
-axis) is the least-squares slope of the robust per-axis variance
-(1.4826 · MAD)² against the age bins' mean age, with its intercept the
-variance at the track's start.
+but the point count: gross losses, which the filter's gate rejects, would
+otherwise set the RMS and the correlations. The correlation interpolates
+across the gaps they leave.
 
-Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8] [--max-error 5]
+Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
+       [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
 """
 import argparse
 import sys
@@ -108,11 +118,11 @@ def main():
         m = (age >= lo) & (age < hi)
         if m.sum() >= 20:
             norm = np.linalg.norm(e[m], axis=1)
-            mad = 1.4826 * np.median(np.abs(e[m] - np.median(e[m], axis=0)), axis=0)
+            robust_sigma = 1.4826 * np.median(np.abs(e[m] - np.median(e[m], axis=0)), axis=0)
             print(f"[{lo:5.2f}, {hi:6.2f})  {int(m.sum()):8d}  {np.sqrt(np.mean(norm ** 2)):12.3f}  "
-                  f"{np.median(norm):15.3f}  {mad[0] ** 2:8.3f} {mad[1] ** 2:8.3f}")
+                  f"{np.median(norm):15.3f}  {robust_sigma[0] ** 2:8.3f} {robust_sigma[1] ** 2:8.3f}")
             mean_age.append(float(np.mean(age[m])))
-            var.append(float(np.mean(mad ** 2)))
+            var.append(float(np.mean(robust_sigma ** 2)))
             weight.append(float(m.sum()))
     if len(var) >= 2:
         w = np.sqrt(np.array(weight))

@@ -63,6 +63,12 @@ void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 
           "Backend::initialize: the initial state is not finite");
   require(P0.allFinite(), "Backend::initialize: the initial covariance is not finite");
   state_ = FilterState();
+  if (options_.slam_track_error_sigma_px > 0.0) {
+    const Vec4 k = sensors_.camera.intrinsics();  // fx fy cx cy: normalised = px / f
+    const double s = options_.slam_track_error_sigma_px;
+    state_.feature_dim = kFeatureDim + kTrackErrorDim;
+    state_.track_error_cov = Vec2(s * s / (k(0) * k(0)), s * s / (k(1) * k(1))).asDiagonal();
+  }
   state_.imu = state;
   state_.imu.q_W_B.normalize();
   state_.P = 0.5 * (P0 + P0.transpose());

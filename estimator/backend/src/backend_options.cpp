@@ -49,6 +49,8 @@ void BackendOptions::validate() const {
   requireField(slam_scene_depth_memory_s > 0.0 && slam_scene_depth_memory_s <= 1e9, "slam_scene_depth_memory_s",
                "must be in (0, 1e9]");
   requireInRange("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s, 0.0, 1e6);
+  requireInRange("slam_track_error_sigma_px", slam_track_error_sigma_px, 0.0, 100.0);
+  requirePositive("slam_track_error_time_s", slam_track_error_time_s);
   requireField(msckf_min_track_length >= 2, "msckf_min_track_length", "must be >= 2");
   requireNonNegative("min_parallax_px", min_parallax_px);
   requireNonNegative("slam_min_parallax_px", slam_min_parallax_px);

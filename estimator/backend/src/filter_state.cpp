@@ -31,7 +31,10 @@ void FilterState::correct(const VecX& dx) {
     clones[i].p_W_C += dx.segment<3>(k + kCloneP);
     clones[i].q_W_C = (clones[i].q_W_C * so3::expQuat(dx.segment<3>(k + kCloneTheta))).normalized();
   }
-  for (std::size_t j = 0; j < features.size(); ++j) features[j].abr += dx.segment<3>(featureIndex(j));
+  for (std::size_t j = 0; j < features.size(); ++j) {
+    features[j].abr += dx.segment<3>(featureIndex(j));
+    if (hasTrackErrors()) features[j].track_error += dx.segment<2>(featureIndex(j) + kFeatureDim);
+  }
   if (has_scene_depth) scene_rho += dx(sceneDepthIndex());
 }
 
@@ -87,13 +90,28 @@ void FilterState::removeClone(std::size_t i) {
 void FilterState::addFeature(const SlamFeature& f, const Mat3& P_ff,
                              const Eigen::Matrix<double, 3, Eigen::Dynamic>& P_fx) {
   require(P_fx.cols() == dim(), "FilterState::addFeature: cross-covariance has the wrong size");
-  insertRowsCols(P, featureIndex(features.size()), P_fx, P_ff);  // after the last feature, before ρ_s
-  features.push_back(f);
+  if (!hasTrackErrors()) {
+    insertRowsCols(P, featureIndex(features.size()), P_fx, P_ff);  // after the last feature, before ρ_s
+    features.push_back(f);
+    return;
+  }
+  MatX B = MatX::Zero(feature_dim, feature_dim);
+  B.topLeftCorner<3, 3>() = P_ff;
+  B.topLeftCorner<2, 2>() += track_error_cov;
+  B.block<2, 2>(0, kFeatureDim) = -track_error_cov;
+  B.block<2, 2>(kFeatureDim, 0) = -track_error_cov;
+  B.block<2, 2>(kFeatureDim, kFeatureDim) = track_error_cov;
+  MatX C = MatX::Zero(feature_dim, dim());
+  C.topRows<3>() = P_fx;
+  insertRowsCols(P, featureIndex(features.size()), C, B);
+  SlamFeature g = f;
+  g.track_error.setZero();
+  features.push_back(g);
 }
 
 void FilterState::removeFeature(std::size_t j) {
   require(j < features.size(), "FilterState::removeFeature: no such feature");
-  removeRowsCols(P, featureIndex(j), kFeatureDim);
+  removeRowsCols(P, featureIndex(j), feature_dim);
   features.erase(features.begin() + static_cast<std::ptrdiff_t>(j));
 }
 
@@ -142,7 +160,11 @@ VecX FilterState::minus(const FilterState& ref) const {
     d.segment<3>(k + kCloneP) = clones[i].p_W_C - ref.clones[i].p_W_C;
     d.segment<3>(k + kCloneTheta) = so3::log(Quat(ref.clones[i].q_W_C.conjugate() * clones[i].q_W_C));
   }
-  for (std::size_t j = 0; j < features.size(); ++j) d.segment<3>(featureIndex(j)) = features[j].abr - ref.features[j].abr;
+  for (std::size_t j = 0; j < features.size(); ++j) {
+    d.segment<3>(featureIndex(j)) = features[j].abr - ref.features[j].abr;
+    if (hasTrackErrors())
+      d.segment<2>(featureIndex(j) + kFeatureDim) = features[j].track_error - ref.features[j].track_error;
+  }
   if (has_scene_depth) d(sceneDepthIndex()) = scene_rho - ref.scene_rho;
   return d;
 }

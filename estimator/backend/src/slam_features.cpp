@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
+#include <cmath>
 
 #include "evio/core/camera/camera_common.h"
 #include "evio/core/error.h"
@@ -26,6 +27,10 @@ bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const 
   H->block<2, 6>(0, state.cloneIndex(c)) += Hc;
   H->block<2, 3>(0, state.featureIndex(j)) = Hf;
   *r = z - zh;
+  if (state.hasTrackErrors()) {  // z = π(h) + e + n
+    H->block<2, 2>(0, state.featureIndex(j) + kFeatureDim).setIdentity();
+    *r -= f.track_error;
+  }
   return true;
 }
 
@@ -52,6 +57,18 @@ bool slamSecondOrderCovariance(const FilterState& state, std::size_t j, std::siz
   const Mat23 Pi = dNormalizedDPoint(h);
   *cov = Pi * cov_h * Pi.transpose();
   return cov->allFinite();
+}
+
+void decayTrackErrors(FilterState& state, double dt_s, double time_s) {
+  if (!state.hasTrackErrors() || !(dt_s > 0.0)) return;
+  const double phi = std::exp(-dt_s / time_s);
+  for (std::size_t j = 0; j < state.features.size(); ++j) {
+    const int k = state.featureIndex(j) + kFeatureDim;
+    state.features[j].track_error *= phi;
+    state.P.middleRows(k, kTrackErrorDim) *= phi;
+    state.P.middleCols(k, kTrackErrorDim) *= phi;
+    state.P.block<2, 2>(k, k) += (1.0 - phi * phi) * state.track_error_cov;
+  }
 }
 
 Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra) {

@@ -29,6 +29,10 @@ void SlamUpdater::diffuseBearings(double dt_s) {
   }
 }
 
+void SlamUpdater::decayTrackErrors(double dt_s) {
+  estimator::decayTrackErrors(state(), dt_s, options().slam_track_error_time_s);
+}
+
 void SlamUpdater::diffuseSceneDepth(double dt_s) {
   if (!state().has_scene_depth || !(dt_s > 0.0)) return;
   const double sigma0 = fixedDepthPriorSigma();

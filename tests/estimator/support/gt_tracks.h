@@ -34,6 +34,12 @@ struct GtTrackOptions {
   /// prior in the filter (as a real tracker re-detecting a corner does), which a
   /// consistency test must avoid.
   bool retrack_landmarks = true;
+  /// A correlated error per track on top of the white noise: a first-order
+  /// Gauss–Markov process e (px per axis), stationary σ track_error_sigma_px,
+  /// correlation time track_error_time_s, drawn from its stationary law when
+  /// the track starts (0: none).
+  double track_error_sigma_px = 0.0;
+  double track_error_time_s = 0.5;
 };
 
 /// Landmarks uniformly in the box [lo, hi].
@@ -113,7 +119,8 @@ class GroundTruthTracks {
         it = live_.erase(it);
         continue;
       }
-      const Vec2 noisy = uv + noise();
+      stepTrackError(tr, t_ns);
+      const Vec2 noisy = uv + noise() + tr.error;
       set.features.push_back({tr.id, noisy, tr.last_uv, true});
       tr.last_uv = noisy;
       ++tr.length;
@@ -135,7 +142,10 @@ class GroundTruthTracks {
         tr.max_length = options_.min_track_length +
                         static_cast<int>(rng_.uniformInt(static_cast<std::uint64_t>(
                             options_.max_track_length - options_.min_track_length + 1)));
-        tr.last_uv = uv + noise();
+        if (options_.track_error_sigma_px > 0.0)  // no draw without it: the white-noise streams stay as they were
+          tr.error = Vec2(rng_.normal(), rng_.normal()) * options_.track_error_sigma_px;
+        tr.error_t_ns = t_ns;
+        tr.last_uv = uv + noise() + tr.error;
         tr.length = 1;
         set.features.push_back({tr.id, tr.last_uv, tr.last_uv, false});
         tracked_[l] = true;
@@ -159,7 +169,18 @@ class GroundTruthTracks {
     int length = 0;
     int max_length = 0;
     Vec2 last_uv = Vec2::Zero();
+    Vec2 error = Vec2::Zero();  ///< the correlated error, px
+    TimeNs error_t_ns = 0;
   };
+
+  // e(t) = φ e(t0) + sqrt(1 − φ²) σ w, φ = exp(−(t − t0)/τ): exact for any step.
+  void stepTrackError(Track& tr, TimeNs t_ns) {
+    if (!(options_.track_error_sigma_px > 0.0)) return;
+    const double phi = std::exp(-nsToSeconds(t_ns - tr.error_t_ns) / options_.track_error_time_s);
+    tr.error = phi * tr.error +
+               std::sqrt(1.0 - phi * phi) * options_.track_error_sigma_px * Vec2(rng_.normal(), rng_.normal());
+    tr.error_t_ns = t_ns;
+  }
 
   bool visible(const Vec3& p_C, Vec2* uv) const {
     return p_C.z() > options_.min_depth_m && camera_.project(p_C, uv) && camera_.isInside(*uv, options_.border_px);

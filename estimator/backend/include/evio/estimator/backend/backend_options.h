@@ -117,6 +117,12 @@ struct BackendOptions {
   /// (docs/algorithms.md#track-drift). 0: a feature's bearing is fixed and
   /// every observation's error independent of the others.
   double slam_bearing_walk_px2_per_s = 0.0;
+  /// Track errors as states (docs/algorithms.md "Track errors as states"):
+  /// each SLAM feature carries the tracker's error e on it, a Gauss–Markov
+  /// process with stationary σ (px per axis) and correlation time, so that
+  /// consecutive observations share it instead of counting it again. 0: off.
+  double slam_track_error_sigma_px = 0.0;
+  double slam_track_error_time_s = 0.5;
   /// How long after the filter's initialisation a SLAM candidate may take the
   /// fixed depth prior (ρ0 = 1/(2 d_min)) when neither a triangulation, the
   /// range finder nor the map gives its depth, s. Before that the track stays
@@ -272,6 +278,9 @@ struct BackendOptions {
       "time over which the scene inverse depth's variance grows by its prior share, s");
     v("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s,
       "track drift: random-walk rate of a SLAM feature's bearing, px^2/s");
+    v("slam_track_error_sigma_px", slam_track_error_sigma_px,
+      "track errors as states: stationary sigma of a SLAM feature's track error, px (0: off)");
+    v("slam_track_error_time_s", slam_track_error_time_s, "track errors as states: correlation time, s");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
     v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");
     v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for an MSCKF triangulation, px");

@@ -9,6 +9,12 @@
 ///
 ///   [ δp_W_B(3) δv_W(3) δθ_B(3) δb_g(3) δb_a(3) | clone 0 (δp_W_C, δθ_C) ... clone M-1 | f_0 (δα δβ δρ) ... f_N-1 | δρ_s ]
 ///
+/// With track-error states (FilterState::feature_dim = 5,
+/// BackendOptions::slam_track_error_sigma_px > 0) each feature's block is
+/// (δα δβ δρ δe_x δe_y): e, normalised image units, the tracker's current
+/// error on this feature, a Gauss–Markov process (docs/algorithms.md "Track
+/// errors as states").
+///
 /// with clones oldest first and features in insertion order; δρ_s, the
 /// scene's inverse depth (1/m), only once it has been added
 /// (BackendOptions::slam_scene_depth_share, docs/algorithms.md "The scene's depth as a state").
@@ -52,13 +58,17 @@ struct SlamFeature {
   FeatureId id = 0;
   std::int64_t anchor_clone_id = 0;
   Vec3 abr = Vec3::Zero();  ///< (α, β, ρ)
+  /// The tracker's error on this feature, z = π(h) + e + n, normalised units
+  /// (only with track-error states: FilterState::feature_dim = 5).
+  Vec2 track_error = Vec2::Zero();
   int gate_failures = 0;    ///< consecutive Mahalanobis gate failures
 };
 
 /// Sizes of the error-state blocks.
 inline constexpr int kImuDim = 15;
 inline constexpr int kCloneDim = 6;
-inline constexpr int kFeatureDim = 3;
+inline constexpr int kFeatureDim = 3;   ///< (α, β, ρ): a feature's block without track-error states
+inline constexpr int kTrackErrorDim = 2;  ///< (e_x, e_y) after (α, β, ρ) with them
 /// Offsets inside the IMU block.
 inline constexpr int kIdxP = 0, kIdxV = 3, kIdxTheta = 6, kIdxBg = 9, kIdxBa = 12;
 /// Offsets inside a clone block.
@@ -77,17 +87,24 @@ class FilterState {
   /// ρ_s has taken its one measurement from the triangulated points.
   bool scene_depth_measured = false;
   MatX P;                            ///< error-state covariance (dim × dim), symmetric PD
+  /// Entries per feature: kFeatureDim, or kFeatureDim + kTrackErrorDim with
+  /// track-error states. Set before the first feature is added.
+  int feature_dim = kFeatureDim;
+  /// Stationary covariance Σ_e of a track error (normalised units²), the
+  /// block a new feature's e starts with (feature_dim = 5).
+  Mat2 track_error_cov = Mat2::Zero();
+  bool hasTrackErrors() const { return feature_dim > kFeatureDim; }
 
-  /// Total error-state dimension 15 + 6 M + 3 N (+ 1 with the scene depth).
+  /// Total error-state dimension 15 + 6 M + feature_dim N (+ 1 with the scene depth).
   int dim() const { return kImuDim + kCloneDim * static_cast<int>(clones.size()) +
-                           kFeatureDim * static_cast<int>(features.size()) + (has_scene_depth ? 1 : 0); }
+                           feature_dim * static_cast<int>(features.size()) + (has_scene_depth ? 1 : 0); }
   /// Covariance index of ρ_s (requires has_scene_depth).
   int sceneDepthIndex() const { return featureIndex(features.size()); }
   /// First covariance index of clone i (position in `clones`).
   int cloneIndex(std::size_t i) const { return kImuDim + kCloneDim * static_cast<int>(i); }
   /// First covariance index of feature j (position in `features`).
   int featureIndex(std::size_t j) const {
-    return kImuDim + kCloneDim * static_cast<int>(clones.size()) + kFeatureDim * static_cast<int>(j);
+    return kImuDim + kCloneDim * static_cast<int>(clones.size()) + feature_dim * static_cast<int>(j);
   }
   /// Position of the clone with `id` in `clones`, or -1.
   int findClone(std::int64_t id) const;
@@ -104,6 +121,9 @@ class FilterState {
   /// Removes clone i and its rows/columns (marginalisation).
   void removeClone(std::size_t i);
   /// Appends a feature with covariance P_ff (3×3) and cross-covariance P_fx (3 × dim()).
+  /// With track-error states its e starts at zero with Σ_e, and the bearing,
+  /// taken from an observation z = (α, β) + e + n, carries −e:
+  /// Cov(δ(α,β)) += Σ_e, Cov(δ(α,β), δe) = −Σ_e, e independent of the rest.
   void addFeature(const SlamFeature& f, const Mat3& P_ff, const Eigen::Matrix<double, 3, Eigen::Dynamic>& P_fx);
   /// Removes feature j and its rows/columns (marginalisation).
   void removeFeature(std::size_t j);

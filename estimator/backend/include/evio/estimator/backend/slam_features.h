@@ -38,6 +38,13 @@ bool slamSecondOrderCovariance(const FilterState& state, std::size_t j, std::siz
 /// W'(σ_z² W⁻¹W⁻ᵀ + extra)W'ᵀ = σ_z² I.
 Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra);
 
+/// The track-error states (filter_state.h, feature_dim = 5) over dt_s: each
+/// e is a first-order Gauss–Markov process with correlation time time_s and
+/// stationary covariance Σ_e (state.track_error_cov), so exactly, for any dt,
+///   e ← φ e,  P's e rows and columns × φ,  P_ee += (1 − φ²) Σ_e,  φ = exp(−dt/τ).
+/// No-op without track-error states or for dt ≤ 0.
+void decayTrackErrors(FilterState& state, double dt_s, double time_s);
+
 /// Depth-prior initialisation (Montiel et al. 2006; xVIO): anchor = clone c,
 /// (α, β) = z, ρ = rho0, with covariance diag(Σ_z, σ_ρ0²) (Σ_z = σ_z² W⁻¹W⁻ᵀ,
 /// W the observation's whitening, feature_track.h; σ_z² I when W = I) and zero

@@ -38,6 +38,8 @@ class SlamUpdater : public Updater {
   /// (α, β) of every SLAM feature gains q Δt / f² of variance, dt_s the time
   /// since the previous measurement set.
   void diffuseBearings(double dt_s);
+  /// Track-error states over dt (slam_features.h decayTrackErrors).
+  void decayTrackErrors(double dt_s);
   /// The scene's inverse depth ρ_s (BackendOptions::slam_scene_depth_share)
   /// random-walks: P_ss += c σ_ρ0² dt_s / slam_scene_depth_memory_s.
   void diffuseSceneDepth(double dt_s);

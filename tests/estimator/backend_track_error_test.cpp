@@ -1,0 +1,162 @@
+// Track errors as states (filter_state.h, feature_dim = 5): the SLAM
+// residual's Jacobian over the whole state including e, a new feature's
+// covariance (its bearing carries −e), and the Gauss–Markov step's
+// exactness over any interval.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "evio/core/random_stream.h"
+#include "evio/core/so3.h"
+#include "evio/estimator/backend/slam_features.h"
+#include "evio/estimator/backend/visual_models.h"
+
+namespace evio::estimator {
+namespace {
+
+Vec3 randVec(RandomStream& rng, double s) { return Vec3(rng.normal(), rng.normal(), rng.normal()) * s; }
+
+// Three clones looking down from 10 m, two features added through
+// addFeature (so with their track-error blocks), track errors nonzero, and
+// a random SPD covariance.
+FilterState makeStateWithTrackErrors(std::uint64_t seed) {
+  RandomStream rng(seed, "track_error_state");
+  FilterState s;
+  s.feature_dim = kFeatureDim + kTrackErrorDim;
+  s.track_error_cov = Vec2(4e-5, 9e-5).asDiagonal();
+  s.imu.p_W_B = Vec3(0.0, 0.0, 10.0);
+  s.imu.q_W_B = so3::expQuat(randVec(rng, 0.1));
+  const Mat3 R_down = Vec3(1.0, -1.0, -1.0).asDiagonal();
+  for (int i = 0; i < 3; ++i) {
+    CameraClone c;
+    c.id = 10 + i;
+    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randVec(rng, 0.05);
+    c.q_W_C = Quat(R_down * so3::exp(randVec(rng, 0.05)));
+    s.clones.push_back(c);
+  }
+  s.P = MatX::Identity(s.dim(), s.dim()) * 1e-3;
+  const Vec3 ground[2] = {Vec3(1.0, 1.0, 0.3), Vec3(-1.5, 0.5, -0.2)};
+  for (int j = 0; j < 2; ++j) {
+    SlamFeature f;
+    f.id = 100 + j;
+    f.anchor_clone_id = 10 + j;
+    EXPECT_TRUE(worldToAnchored(s.clones[static_cast<std::size_t>(j)], ground[j], &f.abr));
+    s.addFeature(f, Mat3::Identity() * 1e-4, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, s.dim()));
+  }
+  for (SlamFeature& f : s.features) f.track_error = Vec2(rng.normal(), rng.normal()) * 0.005;
+  const int n = s.dim();
+  MatX A(n, n);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) A(r, c) = rng.normal();
+  s.P = 1e-3 * (A * A.transpose() / n + MatX::Identity(n, n));
+  return s;
+}
+
+TEST(TrackErrorStates, LayoutHasFiveEntriesPerFeature) {
+  const FilterState s = makeStateWithTrackErrors(1);
+  EXPECT_EQ(s.dim(), kImuDim + 3 * kCloneDim + 2 * 5);
+  EXPECT_EQ(s.featureIndex(1) - s.featureIndex(0), 5);
+  EXPECT_EQ(s.sceneDepthIndex(), s.dim());  // no scene depth: one past the last feature
+}
+
+TEST(TrackErrorStates, SlamResidualJacobianCoversTheTrackError) {
+  const FilterState s = makeStateWithTrackErrors(2);
+  const Vec2 z(0.01, -0.02);
+  for (std::size_t j = 0; j < s.features.size(); ++j) {
+    Eigen::Matrix<double, 2, Eigen::Dynamic> H;
+    Vec2 r;
+    ASSERT_TRUE(slamResidual(s, j, 2, z, &H, &r));
+    // r = z − π(h) − e: H = −∂r/∂δx by central differences over correct().
+    MatX num(2, s.dim());
+    const double h = 1e-6;
+    for (int k = 0; k < s.dim(); ++k) {
+      FilterState sp = s, sm = s;
+      VecX d = VecX::Zero(s.dim());
+      d(k) = h;
+      sp.correct(d);
+      sm.correct(-d);
+      Eigen::Matrix<double, 2, Eigen::Dynamic> Hp, Hm;
+      Vec2 rp, rm;
+      ASSERT_TRUE(slamResidual(sp, j, 2, z, &Hp, &rp));
+      ASSERT_TRUE(slamResidual(sm, j, 2, z, &Hm, &rm));
+      num.col(k) = -(rp - rm) / (2.0 * h);
+    }
+    EXPECT_LT((MatX(H) - num).norm(), 1e-7) << "feature " << j;
+    // The track error enters with the identity, and only the feature's own.
+    const int e = s.featureIndex(j) + kFeatureDim;
+    EXPECT_TRUE(MatX(H.block(0, e, 2, 2)).isApprox(MatX::Identity(2, 2)));
+    const int other = s.featureIndex(1 - j) + kFeatureDim;
+    EXPECT_EQ(MatX(H.block(0, other, 2, 2)).norm(), 0.0);
+  }
+}
+
+TEST(TrackErrorStates, NewFeatureBearingCarriesMinusTheTrackError) {
+  // The bearing from an observation z = b + e + n is b̂ = z, so δb = −(e + n):
+  // Cov(δb) = Σ_n + Σ_e, Cov(δb, δe) = −Σ_e, Cov(δe) = Σ_e, nothing shared
+  // with the rest of the state.
+  FilterState s = makeStateWithTrackErrors(3);
+  const int before = s.dim();
+  Mat3 P_ff = Mat3::Zero();
+  P_ff.topLeftCorner<2, 2>() = Vec2(1e-4, 2e-4).asDiagonal();
+  P_ff(2, 2) = 0.25;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> P_fx = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, before);
+  P_fx(2, 0) = 1e-3;  // a cross-covariance of ρ passes through
+  SlamFeature f;
+  f.id = 200;
+  f.anchor_clone_id = 12;
+  f.abr = Vec3(0.1, 0.2, 0.5);
+  s.addFeature(f, P_ff, P_fx);
+  ASSERT_EQ(s.dim(), before + 5);
+  const int k = s.featureIndex(2);
+  const Mat2& Se = s.track_error_cov;
+  EXPECT_TRUE(MatX(s.P.block(k, k, 2, 2)).isApprox(MatX(P_ff.topLeftCorner<2, 2>() + Se)));
+  EXPECT_TRUE(MatX(s.P.block(k, k + 3, 2, 2)).isApprox(MatX(-Se)));
+  EXPECT_TRUE(MatX(s.P.block(k + 3, k + 3, 2, 2)).isApprox(MatX(Se)));
+  EXPECT_DOUBLE_EQ(s.P(k + 2, k + 2), 0.25);
+  EXPECT_DOUBLE_EQ(s.P(k + 2, 0), 1e-3);
+  EXPECT_EQ(MatX(s.P.block(k + 3, 0, 2, k)).norm(), 0.0);
+  EXPECT_EQ(s.features.back().track_error, Vec2::Zero());
+  // The block is a covariance: positive semi-definite (here definite).
+  const Eigen::LLT<MatX> llt(MatX(s.P.block(k, k, 5, 5)));
+  EXPECT_EQ(llt.info(), Eigen::Success);
+  // Removing the feature restores the former layout.
+  s.removeFeature(2);
+  EXPECT_EQ(s.dim(), before);
+}
+
+TEST(TrackErrorStates, GaussMarkovStepIsExactOverAnyInterval) {
+  // Two steps of dt1 and dt2 are one step of dt1 + dt2 (mean and covariance),
+  // the stationary covariance stays stationary, and the mean decays by
+  // exp(−dt/τ).
+  const double tau = 0.5;
+  FilterState a = makeStateWithTrackErrors(4);
+  FilterState b = a;
+  const Vec2 e0 = a.features[0].track_error;
+  decayTrackErrors(a, 0.013, tau);
+  decayTrackErrors(a, 0.029, tau);
+  decayTrackErrors(b, 0.042, tau);
+  EXPECT_LT((a.P - b.P).norm(), 1e-15);
+  EXPECT_LT((a.features[0].track_error - b.features[0].track_error).norm(), 1e-15);
+  EXPECT_LT((b.features[0].track_error - std::exp(-0.042 / tau) * e0).norm(), 1e-15);
+  // Other entries untouched.
+  const int k = b.featureIndex(0);
+  FilterState c = makeStateWithTrackErrors(4);
+  EXPECT_EQ(b.P.topLeftCorner(k + 3, k + 3), c.P.topLeftCorner(k + 3, k + 3));
+  // Stationary: P_ee = Σ_e with no cross terms stays Σ_e after any step.
+  FilterState d = makeStateWithTrackErrors(5);
+  const int e = d.featureIndex(1) + kFeatureDim;
+  d.P.middleRows(e, 2).setZero();
+  d.P.middleCols(e, 2).setZero();
+  d.P.block(e, e, 2, 2) = d.track_error_cov;
+  decayTrackErrors(d, 0.37, tau);
+  EXPECT_TRUE(MatX(d.P.block(e, e, 2, 2)).isApprox(MatX(d.track_error_cov), 1e-14));
+  // Without track-error states: nothing changes.
+  FilterState plain;
+  plain.P = MatX::Identity(kImuDim, kImuDim);
+  decayTrackErrors(plain, 1.0, tau);
+  EXPECT_EQ(plain.P, MatX::Identity(kImuDim, kImuDim));
+}
+
+}  // namespace
+}  // namespace evio::estimator

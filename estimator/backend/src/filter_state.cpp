@@ -147,7 +147,7 @@ VecX FilterState::yawDirection(const ImuState& x) const {
 
 VecX FilterState::minus(const FilterState& ref) const {
   require(clones.size() == ref.clones.size() && features.size() == ref.features.size() &&
-              has_scene_depth == ref.has_scene_depth,
+              has_scene_depth == ref.has_scene_depth && feature_dim == ref.feature_dim,
           "FilterState::minus: states of different layouts");
   VecX d(dim());
   d.segment<3>(kIdxP) = imu.p_W_B - ref.imu.p_W_B;

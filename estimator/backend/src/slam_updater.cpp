@@ -101,7 +101,7 @@ void SlamUpdater::prune(std::vector<std::size_t> gated_out) {
   std::sort(gated_out.begin(), gated_out.end());
   for (std::size_t q = gated_out.size(); q-- > 0;) removeFeature(gated_out[q]);
   for (std::size_t j = state().features.size(); j-- > 0;)
-    if (!state().features[j].abr.allFinite()) removeFeature(j);
+    if (!state().features[j].abr.allFinite() || !state().features[j].track_error.allFinite()) removeFeature(j);
 }
 
 bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap* tracks) {

@@ -170,12 +170,13 @@ TEST(BackendConsistency, HoverNeverDiverges) {
 
 // Track errors as states (backend.slam_track_error_sigma_px): tracks whose
 // error is white (0.3 px) plus a Gauss–Markov process per track (1 px,
-// 0.5 s), SLAM features only (the MSCKF's observations are still taken as
-// white: msckf_min_track_length above any track). A filter that models the
-// correlated part as a state per feature is consistent (ANEES 6.75 against
-// [5.08, 7.00]); one that takes it as white noise of the same total
-// variance (σ_img 1.044 px, no track-error states) is not: ANEES 18.8, 8.6 %
-// of pose components beyond 3σ (measured with this test, not kept).
+// 0.5 s). A filter that models the correlated part (a state per SLAM
+// feature, the shared error whitened across an MSCKF track's rows) is
+// consistent: ANEES 6.75 against [5.08, 7.00] (SLAM features alone, before
+// the MSCKF's whitening existed: 6.75 too). One that takes it as white
+// noise of the same total variance (σ_img 1.044 px, no track-error states)
+// is not: ANEES 19.7, 9.4 % of pose components beyond 3σ (SLAM alone 18.8;
+// measured with this test, not kept).
 TEST(BackendConsistency, TrackErrorStatesMakeCorrelatedTrackErrorsConsistent) {
   const auto traj = test::scenarioTrajectory("six_dof");
   test::BackendScenario sc = test::sixDofScenario(*traj);
@@ -183,7 +184,7 @@ TEST(BackendConsistency, TrackErrorStatesMakeCorrelatedTrackErrorsConsistent) {
   sc.tracks.pixel_noise_px = 0.3;
   sc.tracks.track_error_sigma_px = 1.0;
   sc.tracks.track_error_time_s = 0.5;
-  sc.backend.msckf_min_track_length = 1000;
+
   sc.backend.sigma_img_px = 0.3;
   sc.backend.slam_track_error_sigma_px = 1.0;
   sc.backend.slam_track_error_time_s = 0.5;

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "evio/core/random_stream.h"
 #include "evio/core/so3.h"
+#include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/visual_models.h"
 
@@ -156,6 +158,66 @@ TEST(TrackErrorStates, GaussMarkovStepIsExactOverAnyInterval) {
   plain.P = MatX::Identity(kImuDim, kImuDim);
   decayTrackErrors(plain, 1.0, tau);
   EXPECT_EQ(plain.P, MatX::Identity(kImuDim, kImuDim));
+}
+
+
+TEST(TrackErrorStates, MsckfRowsOfATrackWithASharedErrorAreWhite) {
+  // Five clones 40 ms apart along x, 3 m from a point, exactly known; one
+  // track observed in all of them with z_i = π_i(p) + e(t_i) + n_i, e a
+  // Gauss–Markov error (σ_e 1 px at f = 300, τ 0.5 s) shared by the track, n
+  // white (σ 0.3 px). Over 4000 draws the null-space projected rows must
+  // have the covariance σ_z² I the update assumes: the mean of the sample
+  // covariance's eigenvalues within 5 % of σ_z², the largest within 25 %.
+  // Without the shared error's whitening (a state without track errors)
+  // the largest eigenvalue is many times σ_z²: the test can fail.
+  const double f = 300.0, sigma_z = 0.3 / f, sigma_e = 1.0 / f, tau = 0.5;
+  const Vec3 p_W(0.1, -0.05, 3.0);
+  const auto makeClones = [](FilterState* s) {
+    for (int i = 0; i < 5; ++i) {
+      CameraClone c;
+      c.id = i;
+      c.t_ns = secondsToNs(0.04 * i);
+      c.p_W_C = Vec3(0.03 * i, 0.005 * i, 0.0);
+      c.q_W_C = Quat::Identity();  // camera z along W's z: the point is in front
+      s->clones.push_back(c);
+    }
+    s->P = MatX::Identity(s->dim(), s->dim()) * 1e-6;
+  };
+  FilterState with, without;
+  with.feature_dim = kFeatureDim + kTrackErrorDim;
+  with.track_error_cov = Mat2::Identity() * sigma_e * sigma_e;
+  with.track_error_time_s = tau;
+  makeClones(&with);
+  makeClones(&without);
+  RandomStream rng(7, "msckf_shared_error");
+  const int draws = 4000, rows = 2 * 5 - 3;
+  MatX S_with = MatX::Zero(rows, rows), S_without = MatX::Zero(rows, rows);
+  for (int d = 0; d < draws; ++d) {
+    FeatureTrack track;
+    track.id = 1;
+    Vec2 e = Vec2(rng.normal(), rng.normal()) * sigma_e;  // stationary start
+    for (std::size_t i = 0; i < 5; ++i) {
+      if (i > 0) {
+        const double phi = std::exp(-0.04 / tau);
+        e = phi * e + std::sqrt(1.0 - phi * phi) * sigma_e * Vec2(rng.normal(), rng.normal());
+      }
+      const Vec3 h = with.clones[i].R_W_C().transpose() * (p_W - with.clones[i].p_W_C);
+      const Vec2 z = h.head<2>() / h.z() + e + Vec2(rng.normal(), rng.normal()) * sigma_z;
+      track.observations.push_back({with.clones[i].id, z, Mat2::Identity()});
+    }
+    MsckfResidual a, b;
+    ASSERT_EQ(msckfResidual(with, track, 0.0, TriangulationOptions{}, &a, sigma_z * sigma_z), MsckfOutcome::kOk);
+    ASSERT_EQ(msckfResidual(without, track, 0.0, TriangulationOptions{}, &b, sigma_z * sigma_z), MsckfOutcome::kOk);
+    ASSERT_EQ(a.r.size(), rows);
+    S_with += a.r * a.r.transpose() / draws;
+    S_without += b.r * b.r.transpose() / draws;
+  }
+  const Eigen::SelfAdjointEigenSolver<MatX> ew(S_with / (sigma_z * sigma_z));
+  const Eigen::SelfAdjointEigenSolver<MatX> eo(S_without / (sigma_z * sigma_z));
+  EXPECT_NEAR(ew.eigenvalues().mean(), 1.0, 0.05);
+  EXPECT_LT(ew.eigenvalues().maxCoeff(), 1.25);
+  EXPECT_GT(ew.eigenvalues().minCoeff(), 0.75);
+  EXPECT_GT(eo.eigenvalues().maxCoeff(), 3.0);
 }
 
 }  // namespace

@@ -68,6 +68,7 @@ void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 
     const double s = options_.slam_track_error_sigma_px;
     state_.feature_dim = kFeatureDim + kTrackErrorDim;
     state_.track_error_cov = Vec2(s * s / (k(0) * k(0)), s * s / (k(1) * k(1))).asDiagonal();
+    state_.track_error_time_s = options_.slam_track_error_time_s;
   }
   state_.imu = state;
   state_.imu.q_W_B.normalize();

@@ -1,5 +1,8 @@
 #include "evio/estimator/backend/msckf_update.h"
 
+#include <Eigen/Cholesky>
+#include <cmath>
+
 #include "evio/estimator/backend/ekf_update.h"
 #include "evio/estimator/backend/visual_models.h"
 
@@ -21,8 +24,36 @@ void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vecto
   }
 }
 
+namespace {
+
+// Rows already whitened one by one (W_i) share the track's error e(t_i):
+// C/σ_z² = I + [ρ_ij W_i Σ_e W_jᵀ / σ_z²], ρ_ij = exp(−|t_i − t_j|/τ); the
+// rows are replaced by L⁻¹ rows, C/σ_z² = L Lᵀ, so their noise is σ_z² I again.
+bool whitenSharedTrackError(const FilterState& state, const std::vector<CameraClone>& clones,
+                            const std::vector<Mat2>& W, double sigma2, MatX* H_x, MatX* H_f, VecX* r) {
+  if (!(sigma2 > 0.0)) return false;
+  const auto n = static_cast<Eigen::Index>(clones.size());
+  MatX C = MatX::Identity(2 * n, 2 * n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double dt = std::abs(nsToSeconds(clones[static_cast<std::size_t>(i)].t_ns -
+                                             clones[static_cast<std::size_t>(j)].t_ns));
+      const double rho = std::exp(-dt / state.track_error_time_s);
+      C.block<2, 2>(2 * i, 2 * j) +=
+          rho * W[static_cast<std::size_t>(i)] * state.track_error_cov * W[static_cast<std::size_t>(j)].transpose() / sigma2;
+    }
+  const Eigen::LLT<MatX> llt(0.5 * (C + C.transpose()));
+  if (llt.info() != Eigen::Success) return false;
+  llt.matrixL().solveInPlace(*H_x);
+  llt.matrixL().solveInPlace(*H_f);
+  llt.matrixL().solveInPlace(*r);
+  return true;
+}
+
+}  // namespace
+
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
-                           const TriangulationOptions& triangulation, MsckfResidual* out) {
+                           const TriangulationOptions& triangulation, MsckfResidual* out, double sigma2_z) {
   std::vector<CameraClone> clones;
   std::vector<std::size_t> pos;
   std::vector<Vec2> z;
@@ -51,6 +82,8 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
     H_f.block<2, 3>(row, 0) = W[i] * Hp;
   }
   if (m <= 3) return MsckfOutcome::kTooShort;
+  if (state.hasTrackErrors() && !whitenSharedTrackError(state, clones, W, sigma2_z, &H_x, &H_f, &r))
+    return MsckfOutcome::kProjectionFailed;
   projectOnLeftNullSpace(H_f, &H_x, &r);
   out->H = std::move(H_x);
   out->r = std::move(r);

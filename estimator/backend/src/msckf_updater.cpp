@@ -14,7 +14,7 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
   for (const FeatureId id : ids) {
     FeatureTrack& track = (*tracks)[id];
     MsckfResidual res;
-    const MsckfOutcome outcome = msckfResidual(state(), track, min_parallax, tri, &res);
+    const MsckfOutcome outcome = msckfResidual(state(), track, min_parallax, tri, &res, sigma2_);
     track.observations.clear();
     if (outcome == MsckfOutcome::kNoParallax) {
       ++stats().msckf_features_no_parallax;

@@ -93,6 +93,9 @@ class FilterState {
   /// Stationary covariance Σ_e of a track error (normalised units²), the
   /// block a new feature's e starts with (feature_dim = 5).
   Mat2 track_error_cov = Mat2::Zero();
+  /// Correlation time τ of the track errors, s (feature_dim = 5): also the
+  /// correlation of one MSCKF track's observations (msckf_update.h).
+  double track_error_time_s = 0.5;
   bool hasTrackErrors() const { return feature_dim > kFeatureDim; }
 
   /// Total error-state dimension 15 + 6 M + feature_dim N (+ 1 with the scene depth).

@@ -6,6 +6,10 @@
 ///   r = z − π(R_iᵀ (p̂_W − p_i)) ≈ H_x δx + H_f δp_W + n,
 /// and project on the left null space of H_f (ekf_update.h) so that the
 /// 2n − 3 residuals r_o = Q2ᵀ r constrain the clone poses only.
+/// With track-error states (filter_state.h) the observations of one track
+/// share the tracker's error, a Gauss–Markov process: the whitened rows'
+/// noise is C = σ_z² I + [exp(−|t_i − t_j|/τ) W_i Σ_e W_jᵀ]_ij, and the
+/// rows are whitened by L⁻¹ (C = σ_z² L Lᵀ) before the projection.
 
 #include <vector>
 
@@ -34,8 +38,10 @@ void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vecto
 /// The null-space projected MSCKF residual of `track`. min_parallax is the
 /// rotation-compensated disparity (normalised units) the track must exceed;
 /// a triangulation that fails knowsDepth(·, triangulation) counts as
-/// kNoParallax too.
+/// kNoParallax too. sigma2_z: σ_z², the noise of one whitened row, needed
+/// only with track-error states (the shared error's whitening; must then be
+/// positive).
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
-                           const TriangulationOptions& triangulation, MsckfResidual* out);
+                           const TriangulationOptions& triangulation, MsckfResidual* out, double sigma2_z = 0.0);
 
 }  // namespace evio::estimator

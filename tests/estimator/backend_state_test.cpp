@@ -8,6 +8,7 @@
 #include "evio/core/error.h"
 
 #include "evio/core/random_stream.h"
+#include "random_state.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/chi_squared.h"
 #include "evio/estimator/backend/imu_propagation.h"
@@ -19,24 +20,25 @@
 namespace evio::estimator {
 namespace {
 
-Vec3 randVec(RandomStream& rng, double s) { return Vec3(rng.normal(), rng.normal(), rng.normal()) * s; }
+using test::randomSpdCovariance;
+using test::randomVec3;
 
 // A downward-looking helicopter state with 4 clones and 4 SLAM features on
 // the ground below, and a random SPD covariance.
 FilterState makeState(std::uint64_t seed) {
   RandomStream rng(seed, "state");
   FilterState s;
-  s.imu.p_W_B = Vec3(0.2, -0.1, 10.0) + randVec(rng, 0.1);
-  s.imu.v_W = randVec(rng, 0.5);
-  s.imu.q_W_B = so3::expQuat(randVec(rng, 0.1));
-  s.imu.b_g = randVec(rng, 0.01);
-  s.imu.b_a = randVec(rng, 0.1);
+  s.imu.p_W_B = Vec3(0.2, -0.1, 10.0) + randomVec3(rng, 0.1);
+  s.imu.v_W = randomVec3(rng, 0.5);
+  s.imu.q_W_B = so3::expQuat(randomVec3(rng, 0.1));
+  s.imu.b_g = randomVec3(rng, 0.01);
+  s.imu.b_a = randomVec3(rng, 0.1);
   const Mat3 R_down = Vec3(1.0, -1.0, -1.0).asDiagonal();  // camera z along −z of W
   for (int i = 0; i < 4; ++i) {
     CameraClone c;
     c.id = 10 + i;
-    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randVec(rng, 0.05);
-    c.q_W_C = Quat(R_down * so3::exp(randVec(rng, 0.05)));
+    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randomVec3(rng, 0.05);
+    c.q_W_C = Quat(R_down * so3::exp(randomVec3(rng, 0.05)));
     s.clones.push_back(c);
   }
   const Vec3 ground[4] = {Vec3(1.0, 1.0, 0.3), Vec3(-1.5, 0.5, -0.2), Vec3(0.5, -2.0, 0.1), Vec3(0.2, 0.3, 0.0)};
@@ -47,11 +49,7 @@ FilterState makeState(std::uint64_t seed) {
     EXPECT_TRUE(worldToAnchored(s.clones[static_cast<std::size_t>(j % 3)], ground[j], &f.abr));
     s.features.push_back(f);
   }
-  const int n = s.dim();
-  MatX A(n, n);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) A(r, c) = rng.normal();
-  s.P = 1e-3 * (A * A.transpose() / n + MatX::Identity(n, n));
+  s.P = randomSpdCovariance(s.dim(), 1e-3, rng);
   return s;
 }
 
@@ -211,11 +209,11 @@ ImuState boxPlus(const ImuState& x, const Eigen::Matrix<double, 15, 1>& d) {
 TEST(BackendStateJacobians, ImuTransitionIsTheJacobianOfTheIntegrator) {
   RandomStream rng(3, "imu");
   ImuState x;
-  x.p_W_B = randVec(rng, 1.0);
-  x.v_W = randVec(rng, 1.0);
-  x.q_W_B = so3::expQuat(randVec(rng, 1.0));
-  x.b_g = randVec(rng, 0.05);
-  x.b_a = randVec(rng, 0.2);
+  x.p_W_B = randomVec3(rng, 1.0);
+  x.v_W = randomVec3(rng, 1.0);
+  x.q_W_B = so3::expQuat(randomVec3(rng, 1.0));
+  x.b_g = randomVec3(rng, 0.05);
+  x.b_a = randomVec3(rng, 0.2);
   ImuSample s0, s1;
   s0.t_ns = 0;
   s1.t_ns = 5'000'000;  // a long 5 ms step, so the higher-order terms matter
@@ -239,8 +237,8 @@ TEST(BackendStateJacobians, ImuTransitionIsTheJacobianOfTheIntegrator) {
 TEST(BackendStateJacobians, CameraPoseOfTheImuState) {
   RandomStream rng(5, "camera");
   ImuState x;
-  x.p_W_B = randVec(rng, 1.0);
-  x.q_W_B = so3::expQuat(randVec(rng, 1.0));
+  x.p_W_B = randomVec3(rng, 1.0);
+  x.q_W_B = so3::expQuat(randomVec3(rng, 1.0));
   const Pose T_B_C(so3::expQuat(Vec3(1.2, -0.3, 0.4)), Vec3(0.05, -0.02, 0.1));
   Eigen::Matrix<double, 6, 15> J;
   const Pose T_W_C = cameraPose(x, T_B_C, &J);

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "evio/core/random_stream.h"
+#include "random_state.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/msckf_update.h"
 #include "evio/estimator/backend/slam_features.h"
@@ -17,7 +18,8 @@
 namespace evio::estimator {
 namespace {
 
-Vec3 randVec(RandomStream& rng, double s) { return Vec3(rng.normal(), rng.normal(), rng.normal()) * s; }
+using test::randomSpdCovariance;
+using test::randomVec3;
 
 // Three clones looking down from 10 m, two features added through
 // addFeature (so with their track-error blocks), track errors nonzero, and
@@ -28,13 +30,13 @@ FilterState makeStateWithTrackErrors(std::uint64_t seed) {
   s.feature_dim = kFeatureDim + kTrackErrorDim;
   s.track_error_cov = Vec2(4e-5, 9e-5).asDiagonal();
   s.imu.p_W_B = Vec3(0.0, 0.0, 10.0);
-  s.imu.q_W_B = so3::expQuat(randVec(rng, 0.1));
+  s.imu.q_W_B = so3::expQuat(randomVec3(rng, 0.1));
   const Mat3 R_down = Vec3(1.0, -1.0, -1.0).asDiagonal();
   for (int i = 0; i < 3; ++i) {
     CameraClone c;
     c.id = 10 + i;
-    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randVec(rng, 0.05);
-    c.q_W_C = Quat(R_down * so3::exp(randVec(rng, 0.05)));
+    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randomVec3(rng, 0.05);
+    c.q_W_C = Quat(R_down * so3::exp(randomVec3(rng, 0.05)));
     s.clones.push_back(c);
   }
   s.P = MatX::Identity(s.dim(), s.dim()) * 1e-3;
@@ -47,11 +49,7 @@ FilterState makeStateWithTrackErrors(std::uint64_t seed) {
     s.addFeature(f, Mat3::Identity() * 1e-4, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, s.dim()));
   }
   for (SlamFeature& f : s.features) f.track_error = Vec2(rng.normal(), rng.normal()) * 0.005;
-  const int n = s.dim();
-  MatX A(n, n);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) A(r, c) = rng.normal();
-  s.P = 1e-3 * (A * A.transpose() / n + MatX::Identity(n, n));
+  s.P = randomSpdCovariance(s.dim(), 1e-3, rng);
   return s;
 }
 

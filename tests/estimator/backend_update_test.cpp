@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "evio/core/random_stream.h"
+#include "random_state.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/chi_squared.h"
 #include "evio/estimator/backend/ekf_update.h"
@@ -17,7 +18,8 @@
 namespace evio::estimator {
 namespace {
 
-Vec3 randVec(RandomStream& rng, double s) { return Vec3(rng.normal(), rng.normal(), rng.normal()) * s; }
+using test::randomSpdCovariance;
+using test::randomVec3;
 
 // n clones along a short arc, looking along +x of W.
 std::vector<CameraClone> arcOfClones(int n, std::uint64_t seed, double baseline_m = 0.3) {
@@ -30,8 +32,8 @@ std::vector<CameraClone> arcOfClones(int n, std::uint64_t seed, double baseline_
   for (int i = 0; i < n; ++i) {
     CameraClone c;
     c.id = i;
-    c.p_W_C = Vec3(0.0, baseline_m * i / std::max(1, n - 1), 0.05 * std::sin(i)) + randVec(rng, 0.01);
-    c.q_W_C = Quat(R_look * so3::exp(randVec(rng, 0.05)));
+    c.p_W_C = Vec3(0.0, baseline_m * i / std::max(1, n - 1), 0.05 * std::sin(i)) + randomVec3(rng, 0.01);
+    c.q_W_C = Quat(R_look * so3::exp(randomVec3(rng, 0.05)));
     out.push_back(c);
   }
   return out;
@@ -52,11 +54,7 @@ FilterState stateWith(const std::vector<CameraClone>& clones, std::uint64_t seed
   RandomStream rng(seed, "cov");
   FilterState s;
   s.clones = clones;
-  const int n = s.dim();
-  MatX A(n, n);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) A(r, c) = rng.normal();
-  s.P = 1e-4 * (A * A.transpose() / n + MatX::Identity(n, n));
+  s.P = randomSpdCovariance(s.dim(), 1e-4, rng);
   return s;
 }
 

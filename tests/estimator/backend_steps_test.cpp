@@ -10,6 +10,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "evio/core/error.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/aux_updaters.h"
 #include "evio/estimator/backend/feature_selection.h"
@@ -338,6 +339,61 @@ TEST(BackendUpdaters, MsckfGivesTwoNMinusThreeRowsAndZeroResidualsForExactObserv
   // The triangulated point is remembered for the depth prior from the map.
   ASSERT_EQ(b.triangulated.points().size(), 1u);
   EXPECT_LT((b.triangulated.points()[0] - p_W).norm(), 1e-9);
+}
+
+// The iterated MSCKF update's rows: at the state residuals() saw, the
+// re-triangulated rows are those rows (the same function of the same
+// inputs, bit for bit); at a state whose clones moved they are the rows
+// linearised there: the residual of observations that were exact for the
+// first clones is no longer zero, and the Jacobian follows the clones.
+TEST(BackendUpdaters, MsckfRowsRelinearizedAtAnIterateAreTheRowsOfThatState) {
+  UpdaterBench b(cloneRow({0.0, 0.25, 0.5}));
+  b.options.msckf_iterations = 3;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  TrackMap tracks;
+  for (FeatureId id = 1; id <= 3; ++id) {
+    const Vec3 p_W(0.25 + 0.1 * static_cast<double>(id), 0.1 - 0.05 * static_cast<double>(id), 1.0 + 0.2 * static_cast<double>(id));
+    FeatureTrack t;
+    t.id = id;
+    for (const CameraClone& c : b.state.clones) {
+      Vec2 z;
+      ASSERT_TRUE(projectWorldPoint(c, p_W, &z));
+      t.observations.push_back({c.id, z + Vec2(noise(rng), noise(rng))});
+    }
+    tracks[id] = t;
+  }
+  TrackMap untouched = tracks;  // residuals() empties the tracks it uses
+  MsckfUpdater msckf(b.context(), kCamera, 1e-4, &b.chi2);
+  const UpdateRows rows = msckf.residuals({1, 2, 3}, &tracks);
+  ASSERT_EQ(msckf.lastCount(), 3);
+  const UpdateRows again = msckf.relinearize(b.state);
+  ASSERT_EQ(again.H.rows(), rows.H.rows());
+  EXPECT_TRUE(again.H == rows.H);
+  EXPECT_TRUE(again.r == rows.r);
+
+  FilterState moved = b.state;
+  moved.clones[2].p_W_C += Vec3(0.0, 0.02, 0.0);
+  const UpdateRows there = msckf.relinearize(moved);
+  ASSERT_EQ(there.H.rows(), rows.H.rows());
+  EXPECT_GT((there.r - rows.r).norm(), 1e-3);
+  EXPECT_GT((there.H - rows.H).norm(), 1e-6);
+  // Without iterations the tracks are not kept: nothing to re-linearise.
+  UpdaterBench once(cloneRow({0.0, 0.25, 0.5}));
+  MsckfUpdater plain(once.context(), kCamera, 1e-4, &once.chi2);
+  EXPECT_EQ(plain.residuals({1, 2, 3}, &untouched).H.rows(), rows.H.rows());
+  EXPECT_EQ(plain.relinearize(once.state).H.rows(), 0);
+}
+
+TEST(BackendOptions, IteratedMsckfRowsNeedTheSlamRowsLinearisedOnce) {
+  BackendOptions o;
+  o.msckf_iterations = 3;
+  EXPECT_NO_THROW(o.validate());
+  o.iekf_iterations = 2;
+  EXPECT_THROW(o.validate(), Error);
+  o.msckf_iterations = 0;
+  o.iekf_iterations = 1;
+  EXPECT_THROW(o.validate(), Error);
 }
 
 // With per-observation covariances R_i = σ_z² W_i⁻¹ W_i⁻ᵀ and P → 0, the

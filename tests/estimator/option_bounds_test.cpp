@@ -43,6 +43,7 @@ const std::vector<Bound>& bounds() {
       {"backend.max_slam_features", "1000", "1000000"},
       {"backend.triangulation_max_iterations", "1000", "1000000000"},
       {"backend.iekf_iterations", "100", "1000000"},
+      {"backend.msckf_iterations", "100", "1000000"},
       {"backend.slam_prior_track_iterations", "50", "1000000",
        {"backend.slam_prior_init_with_track=true", "backend.slam_prior_track_update=true"}},
       {"backend.max_delay_s", "60", "1e9"},

@@ -61,6 +61,9 @@ void BackendOptions::validate() const {
   requirePositive("triangulation_tolerance", triangulation_tolerance);
   requirePositive("triangulation_min_depth_m", triangulation_min_depth_m);
   requireField(iekf_iterations >= 1 && iekf_iterations <= 100, "iekf_iterations", "must be in [1, 100]");
+  requireField(msckf_iterations >= 1 && msckf_iterations <= 100, "msckf_iterations", "must be in [1, 100]");
+  requireField(msckf_iterations == 1 || iekf_iterations == 1, "msckf_iterations",
+               "iterating the MSCKF rows needs iekf_iterations = 1 (the SLAM rows then stay linearised once)");
   requireInRange("max_delay_s", max_delay_s, 0.0, 60.0);  // measurements wait this long in memory
   requireNonNegative("max_late_s", max_late_s);
   requirePositive("max_velocity_mps", max_velocity_mps);

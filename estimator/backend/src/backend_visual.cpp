@@ -75,6 +75,19 @@ bool Backend::stackedUpdate(const std::vector<FeatureObservation>& slam_observat
   const auto slam_rows = [this, &slam_observations, c](const FilterState& x, MatX* H, VecX* r) {
     slam_.relinearize(x, slam_observations, c, H, r);
   };
+  if (options_.msckf_iterations > 1 && msckf_rows.r.size() > 0) {
+    // The MSCKF tracks re-triangulated and re-linearised at every iterate;
+    // the SLAM rows linearised once, at the prior.
+    UpdateRows slam_fixed;
+    slam_rows(state_, &slam_fixed.H, &slam_fixed.r);
+    const auto msckf_relinearized = [this](const FilterState& x, MatX* H, VecX* r) {
+      UpdateRows rows = msckf_.relinearize(x);
+      *H = std::move(rows.H);
+      *r = std::move(rows.r);
+    };
+    return iteratedEkfUpdate(state_, msckf_relinearized, slam_fixed.H, slam_fixed.r, sigma_z_ * sigma_z_,
+                             options_.msckf_iterations, options_.joseph_form);
+  }
   return iteratedEkfUpdate(state_, slam_rows, msckf_rows.H, msckf_rows.r, sigma_z_ * sigma_z_,
                            options_.iekf_iterations, options_.joseph_form);
 }

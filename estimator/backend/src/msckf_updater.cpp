@@ -7,14 +7,34 @@
 
 namespace evio::estimator {
 
+namespace {
+
+UpdateRows stackRows(const std::vector<MsckfResidual>& used, Eigen::Index dim) {
+  Eigen::Index rows = 0;
+  for (const MsckfResidual& u : used) rows += u.r.size();
+  UpdateRows out{MatX(rows, dim), VecX(rows)};
+  Eigen::Index row = 0;
+  for (const MsckfResidual& u : used) {
+    out.H.middleRows(row, u.H.rows()) = u.H;
+    out.r.segment(row, u.r.size()) = u.r;
+    row += u.r.size();
+  }
+  return out;
+}
+
+}  // namespace
+
 UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* tracks) {
   const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
   std::vector<MsckfResidual> used;
+  used_.clear();
   for (const FeatureId id : ids) {
     FeatureTrack& track = (*tracks)[id];
     MsckfResidual res;
     const MsckfOutcome outcome = msckfResidual(state(), track, min_parallax, tri, &res, sigma2_);
+    FeatureTrack copy;
+    if (options().msckf_iterations > 1) copy = track;
     track.observations.clear();
     if (outcome == MsckfOutcome::kNoParallax) {
       ++stats().msckf_features_no_parallax;
@@ -31,20 +51,24 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
     }
     triangulatedPoints().add(res.p_W);
     used.push_back(std::move(res));
+    if (options().msckf_iterations > 1) used_.push_back(std::move(copy));
   }
   last_count_ = static_cast<int>(used.size());
   stats().msckf_features_used += last_count_;
+  return stackRows(used, state().dim());
+}
 
-  Eigen::Index rows = 0;
-  for (const MsckfResidual& u : used) rows += u.r.size();
-  UpdateRows out{MatX(rows, state().dim()), VecX(rows)};
-  Eigen::Index row = 0;
-  for (const MsckfResidual& u : used) {
-    out.H.middleRows(row, u.H.rows()) = u.H;
-    out.r.segment(row, u.r.size()) = u.r;
-    row += u.r.size();
+UpdateRows MsckfUpdater::relinearize(const FilterState& x) const {
+  const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
+  const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
+  std::vector<MsckfResidual> rows;
+  for (const FeatureTrack& track : used_) {
+    MsckfResidual res;
+    if (msckfResidual(x, track, min_parallax, tri, &res, sigma2_) != MsckfOutcome::kOk) continue;
+    constrainAt(x, &res.H);
+    rows.push_back(std::move(res));
   }
-  return out;
+  return stackRows(rows, x.dim());
 }
 
 }  // namespace evio::estimator

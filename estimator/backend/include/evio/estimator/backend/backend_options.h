@@ -191,6 +191,12 @@ struct BackendOptions {
   /// scenario: more iterations oscillate on depth-prior features (the bilinear
   /// ρ·Δp term) and make the filter diverge; keep 1.
   int iekf_iterations = 1;
+  /// Iterations of the MSCKF rows in the visual update (1: each track
+  /// triangulated and linearised once, at the prior). More: each track used
+  /// is triangulated again at every iterate and its rows re-linearised there
+  /// (an iterated EKF for the MSCKF part, the SLAM rows linearised once);
+  /// not together with iekf_iterations > 1.
+  int msckf_iterations = 1;
 
   // Timing ---------------------------------------------------------------------------
   /// The filter state is kept at most this far behind the newest IMU reading;
@@ -294,6 +300,7 @@ struct BackendOptions {
     v("joseph_form", joseph_form, "Joseph-form covariance update");
     v("observability_constraint", observability_constraint, "keep global yaw unobservable (FEJ transition, OC updates)");
     v("iekf_iterations", iekf_iterations, "iterations of the visual update (1: EKF)");
+    v("msckf_iterations", msckf_iterations, "iterations of the MSCKF rows, re-triangulated at each (1: EKF)");
     v("max_delay_s", max_delay_s, "filter lag behind the newest IMU reading, s");
     v("max_late_s", max_late_s, "late measurements applied at the filter state, s");
     v("max_velocity_mps", max_velocity_mps, "velocity bound for divergence, m/s");

@@ -27,12 +27,18 @@ class MsckfUpdater : public Updater {
   UpdateRows residuals(const std::vector<FeatureId>& ids, TrackMap* tracks);
   /// Features used by the last residuals() call.
   int lastCount() const { return last_count_; }
+  /// The rows of the tracks the last residuals() call used, triangulated
+  /// again and linearised at x (an iterate of the update; the same rows as
+  /// residuals() at the state it saw). A track that no longer triangulates
+  /// at x gives no rows.
+  UpdateRows relinearize(const FilterState& x) const;
 
  private:
   Camera camera_;
   double sigma2_;
   const Chi2Table* chi2_;
   int last_count_ = 0;
+  std::vector<FeatureTrack> used_;  // copies of the tracks the last residuals() used
 };
 
 }  // namespace evio::estimator

@@ -235,5 +235,16 @@ TEST(SceneDepthState, OptionsAreChecked) {
   EXPECT_NO_THROW(o.validate());
 }
 
+TEST(BackendOptions, IteratedMsckfRowsNeedTheSlamRowsLinearisedOnce) {
+  BackendOptions o;
+  o.msckf_iterations = 3;
+  EXPECT_NO_THROW(o.validate());
+  o.iekf_iterations = 2;
+  EXPECT_THROW(o.validate(), Error);
+  o.msckf_iterations = 0;
+  o.iekf_iterations = 1;
+  EXPECT_THROW(o.validate(), Error);
+}
+
 }  // namespace
 }  // namespace evio::estimator

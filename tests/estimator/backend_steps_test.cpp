@@ -10,7 +10,6 @@
 #include <unordered_set>
 #include <utility>
 
-#include "evio/core/error.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/aux_updaters.h"
 #include "evio/estimator/backend/feature_selection.h"
@@ -383,17 +382,6 @@ TEST(BackendUpdaters, MsckfRowsRelinearizedAtAnIterateAreTheRowsOfThatState) {
   MsckfUpdater plain(once.context(), kCamera, 1e-4, &once.chi2);
   EXPECT_EQ(plain.residuals({1, 2, 3}, &untouched).H.rows(), rows.H.rows());
   EXPECT_EQ(plain.relinearize(once.state).H.rows(), 0);
-}
-
-TEST(BackendOptions, IteratedMsckfRowsNeedTheSlamRowsLinearisedOnce) {
-  BackendOptions o;
-  o.msckf_iterations = 3;
-  EXPECT_NO_THROW(o.validate());
-  o.iekf_iterations = 2;
-  EXPECT_THROW(o.validate(), Error);
-  o.msckf_iterations = 0;
-  o.iekf_iterations = 1;
-  EXPECT_THROW(o.validate(), Error);
 }
 
 // With per-observation covariances R_i = σ_z² W_i⁻¹ W_i⁻ᵀ and P → 0, the

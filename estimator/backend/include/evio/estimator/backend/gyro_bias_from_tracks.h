@@ -1,0 +1,87 @@
+#pragma once
+/// @file gyro_bias_from_tracks.h
+/// The gyroscope bias from the first second of feature tracks
+/// (docs/algorithms.md#gyroscope-bias-from-tracks), before the filter's first
+/// visual update, so that the filter starts near the bias instead of learning
+/// a turn-on bias of several °/s through its linearisation.
+///
+/// Frames: B the body (IMU), C the camera, R_B_C the camera's attitude in B.
+/// A gyroscope reading is ω_m = ω + b_g + n. Between two keyframes i < j the
+/// camera turns by
+///   R_Ci_Cj(b) = R_B_Cᵀ · ∏_k Exp((ω̄_k − b) Δt_k) · R_B_C,
+/// the product over the IMU intervals in [t_i, t_j] (ω̄_k: the mean of the
+/// interval's end readings, readings interpolated at t_i and t_j). A point
+/// seen along the unit bearings f_i (in Ci) and f_j (in Cj) lies in the
+/// epipolar plane through the translation t_ij, so with
+///   n_k(b) = f_i,k × R_Ci_Cj(b) f_j,k          (normal of that plane)
+/// every feature k of the pair gives tᵀ n_k = 0. Whatever t is, the rotation
+/// alone is scored by
+///   λ_min( Σ_k n_k n_kᵀ ) = min_{‖t‖=1} Σ_k (tᵀ n_k)²
+/// (the eigenvalue form of the epipolar constraint; Kneip & Lynen 2013), which
+/// is zero for the true rotation with noiseless bearings, also when t = 0.
+///
+/// Of K keyframes, keyframe i pairs with keyframe i + ⌈K/2⌉: no keyframe is in
+/// two pairs, so white bearing errors leave the pairs independent (pairs that
+/// share a keyframe have anti-correlated rotation errors, and a covariance
+/// that ignores it is several times too large), and each pair spans half the
+/// window, where the bias's rotation is largest against the bearing noise.
+/// The bias minimises the sum of that cost over the pairs,
+/// by Gauss–Newton on the residuals r_k = tᵀ n_k / s_k with each pair's t
+/// held at the minimising eigenvector during a step (variable projection:
+/// the cost's gradient is the same as if t followed b). s_k is r_k's
+/// first-order standard deviation per unit bearing noise, so the residuals
+/// are equally weighted (Sampson's normalisation). The bearing noise σ² is
+/// estimated from the residuals, the data's covariance is σ² (JᵀJ)⁻¹, and the
+/// estimate is fused with the prior N(b₀, P₀) the filter already had.
+/// Residuals beyond outlier_sigmas · σ are dropped once and the solve re-run.
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "evio/core/eigen_types.h"
+#include "evio/core/imu_sample.h"
+#include "evio/core/time.h"
+#include "evio/estimator/measurements.h"
+
+namespace evio::estimator {
+
+struct GyroBiasFromTracksOptions {
+  /// Minimum features two keyframes must share for their pair to count.
+  int min_features = 8;
+  /// Residuals beyond this many σ are dropped before the final solve.
+  double outlier_sigmas = 3.0;
+  /// Gauss–Newton iterations per solve at most.
+  int max_iterations = 20;
+};
+
+/// Unit bearings of the features seen at one keyframe, sorted by id.
+struct BearingKeyframe {
+  TimeNs t_imu_ns = 0;                              ///< IMU clock
+  std::vector<std::pair<FeatureId, Vec3>> bearings_C;  ///< camera frame, unit norm
+};
+
+struct GyroBiasEstimate {
+  Vec3 b_g = Vec3::Zero();             ///< posterior mean, rad/s
+  Mat3 covariance = Mat3::Zero();      ///< posterior covariance, (rad/s)²
+  bool from_tracks = false;            ///< false: too few pairs, the prior returned unchanged
+  int pairs = 0;                       ///< keyframe pairs used
+  int residuals = 0;                   ///< feature residuals in the final solve
+  int outliers = 0;                    ///< residuals dropped
+  double bearing_sigma_rad = 0.0;      ///< estimated bearing noise σ
+  Vec3 data_b_g = Vec3::Zero();        ///< the tracks' estimate alone (before the prior)
+  Mat3 data_covariance = Mat3::Zero(); ///< its covariance
+};
+
+/// R_Bi_Bj(b): the body's rotation from t0 to t1 (IMU clock) integrated from
+/// `imu` (time-ordered, covering [t0, t1]) with the bias b removed.
+Mat3 integrateGyroRotation(const ImuSamples& imu, TimeNs t0_ns, TimeNs t1_ns, const Vec3& b_g);
+
+/// The estimate from `keyframes` (time-ordered; paired as above) and the gyroscope readings `imu` covering them. Returns the prior
+/// (from_tracks false) when fewer than two pairs share min_features features.
+GyroBiasEstimate estimateGyroBiasFromTracks(const std::vector<BearingKeyframe>& keyframes, const ImuSamples& imu,
+                                            const Mat3& R_B_C, const Vec3& prior_b_g, const Mat3& prior_covariance,
+                                            const GyroBiasFromTracksOptions& options = {});
+
+}  // namespace evio::estimator

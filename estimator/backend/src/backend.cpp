@@ -46,7 +46,9 @@ Backend::Backend(const BackendOptions& options, const BackendSensors& sensors)
 
 // --- initialisation --------------------------------------------------------------------
 
-void Backend::initialize(const ImuState& state) {
+void Backend::initialize(const ImuState& state) { initialize(state, initialCovariance()); }
+
+Eigen::Matrix<double, 15, 15> Backend::initialCovariance() const {
   Eigen::Matrix<double, 15, 15> P0 = Eigen::Matrix<double, 15, 15>::Zero();
   auto var = [](double sigma) { return std::max(sigma * sigma, 1e-12); };
   P0.diagonal().segment<3>(kIdxP).setConstant(var(options_.initial_sigma_p_m));
@@ -54,7 +56,7 @@ void Backend::initialize(const ImuState& state) {
   P0.diagonal().segment<3>(kIdxTheta).setConstant(var(options_.initial_sigma_theta_deg * kDeg));
   P0.diagonal().segment<3>(kIdxBg).setConstant(var(options_.initial_sigma_bg_degps * kDeg));
   P0.diagonal().segment<3>(kIdxBa).setConstant(var(options_.initial_sigma_ba_mps2));
-  initialize(state, P0);
+  return P0;
 }
 
 void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 15>& P0) {

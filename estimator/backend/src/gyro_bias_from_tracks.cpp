@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
 
@@ -64,21 +65,28 @@ double median(std::vector<double> v) {
 }
 
 /// The unit t minimising Σ w_k (tᵀ n_k)² over the kept normals: the
-/// eigenvector of the smallest eigenvalue of Σ w_k n_k n_kᵀ. The weights are
-/// Huber's at 1.345 robust σ of tᵀ n_k, re-weighted three times from the
-/// normals' directions alone (w = 1/‖n_k‖²): a wrong correspondence has a
-/// long normal and would otherwise set t alone.
-Vec3 translationDirection(const std::vector<Vec3>& n, const std::vector<bool>& kept) {
+/// eigenvector of the smallest eigenvalue of Σ w_k n_k n_kᵀ, its sign that of
+/// `near`.
+Vec3 weightedDirection(const std::vector<Vec3>& n, const std::vector<bool>& kept, const std::vector<double>& w,
+                       const Vec3& near) {
+  Mat3 M = Mat3::Zero();
+  for (std::size_t k = 0; k < n.size(); ++k)
+    if (kept[k]) M += w[k] * n[k] * n[k].transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(M);
+  const Vec3 t = eig.eigenvectors().col(0);  // eigenvalues ascending
+  return t.dot(near) < 0.0 ? Vec3(-t) : t;
+}
+
+/// Robust weights for weightedDirection: Huber's at 1.345 robust σ of
+/// tᵀ n_k, re-weighted three times from the normals' directions alone
+/// (w = 1/‖n_k‖²): a wrong correspondence has a long normal and would
+/// otherwise set t alone.
+std::vector<double> directionWeights(const std::vector<Vec3>& n, const std::vector<bool>& kept) {
   std::vector<double> w(n.size());
   for (std::size_t k = 0; k < n.size(); ++k) w[k] = 1.0 / std::max(n[k].squaredNorm(), 1e-12);
-  Vec3 t = Vec3::UnitZ();
-  for (int round = 0; round < 4; ++round) {
-    Mat3 M = Mat3::Zero();
-    for (std::size_t k = 0; k < n.size(); ++k)
-      if (kept[k]) M += w[k] * n[k] * n[k].transpose();
-    Eigen::SelfAdjointEigenSolver<Mat3> eig;
-    eig.computeDirect(M);
-    t = eig.eigenvectors().col(0);  // eigenvalues ascending
+  for (int round = 0; round < 3; ++round) {
+    const Vec3 t = weightedDirection(n, kept, w, Vec3::UnitZ());
     std::vector<double> a;
     for (std::size_t k = 0; k < n.size(); ++k)
       if (kept[k]) a.push_back(std::abs(t.dot(n[k])));
@@ -88,7 +96,7 @@ Vec3 translationDirection(const std::vector<Vec3>& n, const std::vector<bool>& k
       w[k] = r > c && c > 0.0 ? c / r : 1.0;
     }
   }
-  return t;
+  return w;
 }
 
 /// First-order σ of r = tᵀ(f_i × g), g = R f_j, per unit bearing noise on
@@ -101,7 +109,10 @@ double residualScale(const Vec3& f_i, const Vec3& g, const Vec3& t) {
 }
 
 /// The linearised problem of all pairs at b: residuals r (normalised) and
-/// their Jacobian J (by central differences in b, t and the scales held).
+/// their Jacobian J by central differences in b, each pair's t following b
+/// (re-solved with the weights of b; variable projection: with t held, the
+/// steps crawl along the valley where a rotation error and a tilted t trade
+/// off), the scales s_k held.
 struct Linearization {
   Eigen::VectorXd r;
   Eigen::Matrix<double, Eigen::Dynamic, 3> J;
@@ -118,20 +129,39 @@ Linearization linearize(const std::vector<Pair>& pairs, const Mask& kept, const 
   for (std::size_t p = 0; p < pairs.size(); ++p) {
     const Pair& pair = pairs[p];
     const Mat3 R = cameraRotation(pair, imu, R_B_C, b);
-    const Vec3 t = translationDirection(normals(pair, R), kept[p]);
+    const std::vector<Vec3> n = normals(pair, R);
+    // t minimises the normalised cost Σ w_k (tᵀ n_k / s_k)², the scales
+    // s_k taken at the previous t (twice from the robust fit): with t from
+    // the raw cost, t and b would minimise different costs and b is biased
+    // (0.56 °/s at 0.5 px of noise on a simulated cloud).
+    std::vector<double> w = directionWeights(n, kept[p]);
+    Vec3 t = weightedDirection(n, kept[p], w, Vec3::UnitZ());
+    const std::vector<double> w_robust = w;
+    for (int round = 0; round < 2; ++round) {
+      for (std::size_t k = 0; k < n.size(); ++k) {
+        const Correspondence& c = pair.features[k];
+        const double s = residualScale(c.f_i, R * c.f_j, t);
+        w[k] = w_robust[k] / (s * s);
+      }
+      t = weightedDirection(n, kept[p], w, t);
+    }
     Mat3 R_plus[3], R_minus[3];
+    Vec3 t_plus[3], t_minus[3];
     for (int d = 0; d < 3; ++d) {
       R_plus[d] = cameraRotation(pair, imu, R_B_C, b + kStep * Vec3::Unit(d));
       R_minus[d] = cameraRotation(pair, imu, R_B_C, b - kStep * Vec3::Unit(d));
+      t_plus[d] = weightedDirection(normals(pair, R_plus[d]), kept[p], w, t);
+      t_minus[d] = weightedDirection(normals(pair, R_minus[d]), kept[p], w, t);
     }
     for (std::size_t k = 0; k < pair.features.size(); ++k) {
       if (!kept[p][k]) continue;
       const Correspondence& c = pair.features[k];
       const double s = residualScale(c.f_i, R * c.f_j, t);
-      const auto residual = [&](const Mat3& Rx) { return t.dot(c.f_i.cross(Rx * c.f_j)) / s; };
-      r.push_back(residual(R));
+      const auto residual = [&](const Mat3& Rx, const Vec3& tx) { return tx.dot(c.f_i.cross(Rx * c.f_j)) / s; };
+      r.push_back(residual(R, t));
       Eigen::RowVector3d row;
-      for (int d = 0; d < 3; ++d) row(d) = (residual(R_plus[d]) - residual(R_minus[d])) / (2.0 * kStep);
+      for (int d = 0; d < 3; ++d)
+        row(d) = (residual(R_plus[d], t_plus[d]) - residual(R_minus[d], t_minus[d])) / (2.0 * kStep);
       J.push_back(row);
     }
   }
@@ -141,8 +171,6 @@ Linearization linearize(const std::vector<Pair>& pairs, const Mask& kept, const 
   for (std::size_t i = 0; i < J.size(); ++i) lin.J.row(static_cast<Eigen::Index>(i)) = J[i];
   return lin;
 }
-
-
 
 /// The robust spread of the residuals: 1.4826 · median |r|.
 double robustSigma(const Eigen::VectorXd& r) {
@@ -172,6 +200,65 @@ Linearization solve(const std::vector<Pair>& pairs, const Mask& kept, const ImuS
     if (step.norm() < 1e-9) break;
   }
   return lin;
+}
+
+/// A pair's body rotation near b0 to first order: R(b) ≈ R0 · Exp(G (b − b0)).
+struct PairRotationModel {
+  Mat3 R0, G;
+};
+
+/// The search's cost at b0 + delta: Σ over pairs of λ_min(Σ_k u_k u_kᵀ), u_k
+/// the unit epipolar normals (each feature the same weight).
+double eigenvalueCost(const std::vector<Pair>& pairs, const std::vector<PairRotationModel>& models, const Mat3& R_B_C,
+                      const Vec3& delta) {
+  double cost = 0.0;
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    const Mat3 R = R_B_C.transpose() * models[p].R0 * so3::exp(models[p].G * delta) * R_B_C;
+    Mat3 M = Mat3::Zero();
+    for (const Correspondence& c : pairs[p].features) {
+      const Vec3 n = c.f_i.cross(R * c.f_j);
+      M += n * n.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Mat3> eig;
+    eig.computeDirect(M, Eigen::EigenvaluesOnly);
+    cost += eig.eigenvalues()(0);
+  }
+  return cost;
+}
+
+/// Starting points for Gauss–Newton: the options.starts lowest points of
+/// the eigenvalue cost on a grid over the prior's ±grid_sigmas · σ box (per
+/// axis, grid_steps_per_sigma points per σ), the rotations to first order in
+/// the bias.
+std::vector<Vec3> gridStarts(const std::vector<Pair>& pairs, const ImuSamples& imu, const Mat3& R_B_C,
+                             const Vec3& prior_b_g, const Mat3& prior_covariance,
+                             const GyroBiasFromTracksOptions& options) {
+  constexpr double kStep = 1e-3;  // rad/s, for G
+  std::vector<PairRotationModel> models;
+  for (const Pair& p : pairs) {
+    PairRotationModel m;
+    m.R0 = integrateGyroRotation(imu, p.t_i, p.t_j, prior_b_g);
+    for (int d = 0; d < 3; ++d)
+      m.G.col(d) =
+          so3::log(m.R0.transpose() * integrateGyroRotation(imu, p.t_i, p.t_j, prior_b_g + kStep * Vec3::Unit(d))) /
+          kStep;
+    models.push_back(m);
+  }
+  const int half = static_cast<int>(std::lround(options.grid_sigmas * options.grid_steps_per_sigma));
+  const Vec3 step = prior_covariance.diagonal().cwiseSqrt() / options.grid_steps_per_sigma;
+  std::vector<std::pair<double, Vec3>> scored;
+  for (int x = -half; x <= half; ++x)
+    for (int y = -half; y <= half; ++y)
+      for (int z = -half; z <= half; ++z) {
+        const Vec3 delta = step.cwiseProduct(Vec3(x, y, z));
+        scored.emplace_back(eigenvalueCost(pairs, models, R_B_C, delta), prior_b_g + delta);
+      }
+  const std::size_t n = std::min(static_cast<std::size_t>(options.starts), scored.size());
+  std::partial_sort(scored.begin(), scored.begin() + static_cast<std::ptrdiff_t>(n), scored.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Vec3> starts;
+  for (std::size_t i = 0; i < n; ++i) starts.push_back(scored[i].second);
+  return starts;
 }
 
 }  // namespace
@@ -209,8 +296,18 @@ GyroBiasEstimate estimateGyroBiasFromTracks(const std::vector<BearingKeyframe>& 
   for (std::size_t p = 0; p < pairs.size(); ++p) kept[p].assign(pairs[p].features.size(), true);
   // A robust solve on everything, then the residuals beyond outlier_sigmas
   // of the robust spread dropped and a least-squares solve on the rest.
+  // Gauss–Newton from each start; the solution with the smallest robust
+  // spread of its residuals wins.
   Vec3 b = prior_b_g;
-  Linearization lin = solve(pairs, kept, imu, R_B_C, options.max_iterations, true, &b);
+  Linearization lin;
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& start : gridStarts(pairs, imu, R_B_C, prior_b_g, prior_covariance, options)) {
+    Vec3 candidate = start;
+    Linearization l = solve(pairs, kept, imu, R_B_C, options.max_iterations, true, &candidate);
+    const double spread = robustSigma(l.r);
+    if (spread < best && candidate.allFinite()) best = spread, b = candidate, lin = std::move(l);
+  }
+  if (!std::isfinite(best)) return out;
   const double gate = options.outlier_sigmas * robustSigma(lin.r);
   Eigen::Index i = 0;
   for (std::size_t p = 0; p < pairs.size(); ++p)

@@ -109,6 +109,7 @@ class PipelineRun {
   void takeSnapshot(ItemSnapshot& snapshot) const;
   void consume(BackendWork& work);
   void afterItem(const ItemSnapshot& snapshot);
+  void closeBackend();
   void writeTiming(TimeNs t_ns, std::uint64_t events_read);
   void finish();
   io::EstimateStatus finalStatus() const;
@@ -270,7 +271,11 @@ void PipelineRun::setupStages() {
   } else {
     result_.notes.push_back("static initialisation: position and yaw zero, the estimate needs alignment");
   }
-  backend_stage_ = std::make_unique<BackendStage>(*backend_, std::move(initializer));
+  std::optional<GyroBiasWindow> gyro_bias_window;
+  if (options_.init.gyro_bias_window_s > 0.0)
+    gyro_bias_window.emplace(options_.init.gyro_bias_window_s, options_.init.gyro_bias_keyframe_s,
+                             tracker_camera_->camera, tracker_camera_->T_B_C.rotation(), offset_ns_);
+  backend_stage_ = std::make_unique<BackendStage>(*backend_, std::move(initializer), std::move(gyro_bias_window));
   health_ = std::make_unique<HealthMonitor>(options_.health);
 }
 
@@ -338,10 +343,27 @@ void PipelineRun::consume(BackendWork& work) {
   if (stop && options_.output.stop_on_divergence) stopped_.store(true);
 }
 
+/// After the last item (the backend thread, if any, has stopped): what the
+/// backend stage still holds (an open gyroscope-bias window) goes through.
+void PipelineRun::closeBackend() {
+  if (stopped_.load(std::memory_order_relaxed)) return;
+  estimates_.clear();
+  {
+    StageTimer timer(&result_.times.backend_s);
+    backend_stage_->finish(estimates_);
+  }
+  checked_.clear();
+  for (Estimate& e : estimates_) health_->process(e, checked_);
+  StageTimer timer(&result_.times.output_s);
+  for (const Estimate& e : checked_) writer_->addEstimate(e);
+  if (backend_->initialized() && !result_.initialization_t_ns)
+    result_.initialization_t_ns = backend_->initializedAt() - offset_ns_;
+}
+
 void PipelineRun::afterItem(const ItemSnapshot& snapshot) {
   const TimeNs t_ns = snapshot.t_now;
   if (backend_->initialized() && !result_.initialization_t_ns)
-    result_.initialization_t_ns = backend_->state().imu.t_ns - offset_ns_;
+    result_.initialization_t_ns = backend_->initializedAt() - offset_ns_;
   // The IMU must keep up with the other streams: a run of data without IMU
   // longer than imu_fail_gap_s after initialisation fails like a gap.
   if (backend_->initialized() && backend_->status().ok() && snapshot.have_imu && !pipeline_failure_ &&
@@ -409,6 +431,7 @@ void PipelineRun::loop() {
       consume(work);
   }
   if (handoff) handoff->finish();
+  closeBackend();
   reading_cpu_.flush();
   backend_thread_cpu_.flushByWall();  // the backend thread has stopped
   // The run ends at the last item the backend side took (the same item
@@ -434,6 +457,7 @@ void PipelineRun::loop() {
     result_.track_lag = frontend_->trackLag();
   }
   result_.counts.measurement_sets = backend_stage_->numMeasurementSets();
+  result_.gyro_bias = backend_stage_->gyroBiasEstimate();
 }
 
 io::EstimateStatus PipelineRun::finalStatus() const {

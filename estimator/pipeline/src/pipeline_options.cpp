@@ -15,6 +15,12 @@ void InitOptions::validate() const {
   requireNonNegative("start_offset_s", start_offset_s);
   requirePositive("velocity_half_window_s", velocity_half_window_s);
   requireField(!perturb || mode == "groundtruth", "perturb", "needs mode groundtruth (it perturbs the ground-truth start)");
+  requireNonNegative("gyro_bias_window_s", gyro_bias_window_s);
+  requireField(gyro_bias_window_s == 0.0 || mode == "groundtruth", "gyro_bias_window_s",
+               "needs mode groundtruth (static initialisation takes the bias from the still window)");
+  requirePositive("gyro_bias_keyframe_s", gyro_bias_keyframe_s);
+  requireField(gyro_bias_window_s == 0.0 || gyro_bias_keyframe_s * 3.0 <= gyro_bias_window_s, "gyro_bias_keyframe_s",
+               "at most a third of gyro_bias_window_s (the estimate needs two keyframe pairs)");
 }
 
 void CalibrationOptions::validate() const {

@@ -2,6 +2,8 @@
 // stage took and the backend's counters (each struct through its fields()).
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+
 #include "evio/core/io/config.h"
 #include "evio/core/version.h"
 #include "evio/estimator/pipeline/pipeline.h"
@@ -13,6 +15,31 @@ namespace {
 void emitSeconds(YAML::Emitter& out, const char* key, double v) {
   out << YAML::Key << key << YAML::Value;
   config::emitDouble(out, v);
+}
+
+void emitVector(YAML::Emitter& out, const char* key, const Vec3& v) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < 3; ++i) config::emitDouble(out, v(i));
+  out << YAML::EndSeq;
+}
+
+/// The gyroscope bias from the first tracks, in °/s: the posterior and the
+/// tracks' estimate alone, each with its per-axis σ.
+void emitGyroBias(YAML::Emitter& out, const GyroBiasEstimate& e) {
+  constexpr double kDeg = 180.0 / M_PI;
+  out << YAML::Key << "gyro_bias_from_tracks" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "from_tracks" << YAML::Value << e.from_tracks;
+  emitVector(out, "b_g_degps", kDeg * e.b_g);
+  emitVector(out, "sigma_degps", kDeg * e.covariance.diagonal().cwiseSqrt());
+  if (e.from_tracks) {
+    emitVector(out, "tracks_b_g_degps", kDeg * e.data_b_g);
+    emitVector(out, "tracks_sigma_degps", kDeg * e.data_covariance.diagonal().cwiseSqrt());
+    out << YAML::Key << "pairs" << YAML::Value << e.pairs;
+    out << YAML::Key << "residuals" << YAML::Value << e.residuals;
+    out << YAML::Key << "outliers" << YAML::Value << e.outliers;
+    emitSeconds(out, "bearing_sigma_rad", e.bearing_sigma_rad);
+  }
+  out << YAML::EndMap;
 }
 
 }  // namespace
@@ -51,6 +78,7 @@ std::string formatPipelineSummary(const PipelineResult& r, const PipelineOptions
     emitSeconds(out, "tau_s", r.track_lag->tau_s);
     out << YAML::EndMap;
   }
+  if (r.gyro_bias) emitGyroBias(out, *r.gyro_bias);
   out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
   for (const auto& n : r.notes) out << n;
   out << YAML::EndSeq;

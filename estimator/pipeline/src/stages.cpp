@@ -99,16 +99,46 @@ void TracksStage::process(SequenceItem& in, std::vector<BackendInput>& out) {
 
 // --- BackendStage --------------------------------------------------------------------
 
-BackendStage::BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer)
-    : backend_(backend), initializer_(std::move(initializer)) {
+BackendStage::BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer,
+                           std::optional<GyroBiasWindow> gyro_bias_window)
+    : backend_(backend), initializer_(std::move(initializer)), window_(std::move(gyro_bias_window)) {
   if (!initializer_) backend_.setAutoStaticInitialization(true);
 }
 
 void BackendStage::process(BackendInput& in, std::vector<Estimate>& out) {
-  if (const auto* imu = std::get_if<ImuSample>(&in)) {
-    if (initializer_ && !backend_.initialized()) {
-      if (const std::optional<ImuState> x0 = initializer_->offer(imu->t_ns)) backend_.initialize(*x0);
+  if (window_ && window_->collecting()) {
+    if (window_->add(std::move(in))) closeWindow(out);
+    return;
+  }
+  if (const auto* imu = std::get_if<ImuSample>(&in); imu && initializer_ && !backend_.initialized() && !gyro_bias_) {
+    if (const std::optional<ImuState> x0 = initializer_->offer(imu->t_ns)) {
+      if (window_) {
+        window_->open(*x0);
+        if (window_->add(std::move(in))) closeWindow(out);
+        return;
+      }
+      backend_.initialize(*x0);
     }
+  }
+  feed(in, out);
+}
+
+void BackendStage::finish(std::vector<Estimate>& out) {
+  if (window_ && window_->collecting()) closeWindow(out);
+}
+
+void BackendStage::closeWindow(std::vector<Estimate>& out) {
+  Eigen::Matrix<double, 15, 15> P0 = backend_.initialCovariance();
+  gyro_bias_ = window_->estimate(P0.block<3, 3>(kIdxBg, kIdxBg));
+  ImuState x0 = window_->initialState();
+  x0.b_g = gyro_bias_->b_g;
+  P0.block<3, 3>(kIdxBg, kIdxBg) = gyro_bias_->covariance;
+  backend_.initialize(x0, P0);
+  for (BackendInput& in : window_->takeInputs()) feed(in, out);
+}
+
+void BackendStage::feed(BackendInput& in, std::vector<Estimate>& out) {
+  if (const auto* imu = std::get_if<ImuSample>(&in)) {
     backend_.addImu(*imu);
   } else if (const auto* set = std::get_if<MeasurementSet>(&in)) {
     backend_.addMeasurementSet(*set);

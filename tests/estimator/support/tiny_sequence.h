@@ -46,6 +46,7 @@ struct TinySequenceOptions {
   bool events = false;                  ///< a few events per millisecond (events.txt)
   std::vector<std::pair<double, double>> imu_gaps_s;  ///< [t0, t1) without IMU readings
   double imu_end_s = -1.0;              ///< imu.txt ends here (< 0: at the end)
+  Vec3 gyro_bias_radps = Vec3::Zero();  ///< the simulated gyroscope's bias at the start
   std::uint64_t seed = 1;
 };
 
@@ -100,7 +101,9 @@ inline void writeTinySequence(const std::string& folder, const TinySequenceOptio
   else io::writeCalibTxt(path("calib.txt"), io::calibTxtFromCamera(camera));
 
   // IMU.
-  ImuSimulator sim(*traj, tinyImuOptions(o.imu_rate_hz), o.seed);
+  ImuSimulator::Options imu_options = tinyImuOptions(o.imu_rate_hz);
+  imu_options.gyroscope_initial_bias_radps = o.gyro_bias_radps;
+  ImuSimulator sim(*traj, imu_options, o.seed);
   ImuSamples imu;
   ImuMeasurement m;
   const TimeNs imu_end = o.imu_end_s >= 0.0 ? t0 + secondsToNs(o.imu_end_s) : t_end;

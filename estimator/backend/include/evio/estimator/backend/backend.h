@@ -72,6 +72,10 @@ class Backend {
   void initialize(const ImuState& state);
   /// The same with an explicit 15×15 initial covariance (filter_state.h order).
   void initialize(const ImuState& state, const Eigen::Matrix<double, 15, 15>& P0);
+  /// The options' initial covariance: diagonal, from initial_sigma_*.
+  Eigen::Matrix<double, 15, 15> initialCovariance() const;
+  /// The filter time initialize() was given (IMU clock); 0 before.
+  TimeNs initializedAt() const { return initialized_at_; }
   /// Static initialisation (static_initializer.h) from still readings: roll,
   /// pitch and gyro bias from the window, position and yaw zero. False when the
   /// readings are not still; the backend then stays uninitialised.

@@ -47,6 +47,7 @@
 
 #include "evio/core/io/status_yaml.h"
 #include "evio/estimator/backend/backend_status.h"
+#include "evio/estimator/backend/gyro_bias_from_tracks.h"
 #include "evio/estimator/pipeline/pipeline_options.h"
 
 namespace evio::estimator {
@@ -179,6 +180,8 @@ struct PipelineResult {
   /// (frontend.track_lag.estimate; track_lag.h).
   std::optional<TrackLag> track_lag;
   std::optional<EkltSolverCounts> eklt;  ///< EKLT-VIO only
+  /// The gyroscope bias estimated from the first tracks (init.gyro_bias_window_s > 0).
+  std::optional<GyroBiasEstimate> gyro_bias;
   std::vector<std::string> notes;  ///< degraded modes and choices made (one line each)
 };
 

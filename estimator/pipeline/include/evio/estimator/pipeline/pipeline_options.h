@@ -61,6 +61,12 @@ struct InitOptions {
   /// filter states, as a NEES study needs. Off: the truth exactly (the paper's
   /// protocol), an error of zero under a covariance that is not.
   bool perturb = false;
+  /// With mode groundtruth: estimate the gyroscope bias from this long of
+  /// tracks before the filter's first update (gyro_bias_window.h), s; 0: off
+  /// (the initial state's bias and σ, backend.initial_sigma_bg_degps, stand).
+  double gyro_bias_window_s = 0.0;
+  /// Keyframe spacing inside that window, s.
+  double gyro_bias_keyframe_s = 0.1;
 
   template <class V>
   void fields(V& v) {
@@ -68,6 +74,8 @@ struct InitOptions {
     v("start_offset_s", start_offset_s, "initialise this long after the start of the data, s");
     v("velocity_half_window_s", velocity_half_window_s, "half-width of the velocity difference, s");
     v("perturb", perturb, "groundtruth: add an error drawn from the backend's initial covariance");
+    v("gyro_bias_window_s", gyro_bias_window_s, "groundtruth: gyroscope bias from this long of tracks first, s (0: off)");
+    v("gyro_bias_keyframe_s", gyro_bias_keyframe_s, "keyframe spacing in the gyroscope-bias window, s");
   }
   void validate() const;
 };

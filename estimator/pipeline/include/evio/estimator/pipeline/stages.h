@@ -24,7 +24,9 @@
 #include "evio/estimator/frontend/frontend.h"
 #include "evio/estimator/frontend/synchronizer.h"
 #include "evio/estimator/measurements.h"
+#include "evio/estimator/pipeline/backend_input.h"
 #include "evio/estimator/pipeline/groundtruth_init.h"
+#include "evio/estimator/pipeline/gyro_bias_window.h"
 #include "evio/estimator/pipeline/sequence_reader.h"
 #include "evio/estimator/pipeline/stage.h"
 #include "evio/estimator/pipeline/tracks_input.h"
@@ -43,10 +45,6 @@ struct FrontendOutput {
   /// (frontend.track_lag.estimate), for the synchroniser to compensate.
   std::optional<TrackLag> lag;
 };
-
-/// What the backend consumes: IMU samples (IMU clock), measurement sets and
-/// range readings (camera clock), each stream in time order.
-using BackendInput = std::variant<ImuSample, MeasurementSet, RangeMeasurement>;
 
 /// Event pre-filters (event_prefilter.h); other items pass unchanged.
 class PrefilterStage : public Stage<SequenceItem, SequenceItem> {
@@ -106,19 +104,31 @@ class TracksStage : public Stage<SequenceItem, BackendInput> {
 };
 
 /// The EKF (backend.h): initialised from ground truth when the caller gave
-/// an initializer, else by the backend's own static initialisation.
+/// an initializer, else by the backend's own static initialisation. With a
+/// gyroscope-bias window (gyro_bias_window.h) the initial state's bias comes
+/// from the window's tracks, and the window's inputs reach the filter after it.
 class BackendStage : public Stage<BackendInput, Estimate> {
  public:
-  BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer);
+  BackendStage(Backend& backend, std::optional<GroundTruthInitializer> initializer,
+               std::optional<GyroBiasWindow> gyro_bias_window = std::nullopt);
   void process(BackendInput& in, std::vector<Estimate>& out) override;
+  /// At the end of the data: a window still open is closed with what it holds.
+  void finish(std::vector<Estimate>& out);
   std::uint64_t numMeasurementSets() const { return measurement_sets_; }
   /// Features in the latest measurement set received (0 before the first):
   /// timing.txt's features column.
   std::size_t lastSetFeatures() const { return last_set_features_; }
+  /// The window's estimate, once it closed.
+  const std::optional<GyroBiasEstimate>& gyroBiasEstimate() const { return gyro_bias_; }
 
  private:
+  void feed(BackendInput& in, std::vector<Estimate>& out);
+  void closeWindow(std::vector<Estimate>& out);
+
   Backend& backend_;
   std::optional<GroundTruthInitializer> initializer_;
+  std::optional<GyroBiasWindow> window_;
+  std::optional<GyroBiasEstimate> gyro_bias_;
   std::uint64_t measurement_sets_ = 0;
   std::size_t last_set_features_ = 0;
 };

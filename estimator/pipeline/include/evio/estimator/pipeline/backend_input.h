@@ -1,0 +1,15 @@
+#pragma once
+/// @file backend_input.h
+/// What the backend consumes (stages.h): IMU samples (IMU clock), measurement
+/// sets and range readings (camera clock), each stream in time order.
+
+#include <variant>
+
+#include "evio/core/imu_sample.h"
+#include "evio/estimator/measurements.h"
+
+namespace evio::estimator {
+
+using BackendInput = std::variant<ImuSample, MeasurementSet, RangeMeasurement>;
+
+}  // namespace evio::estimator

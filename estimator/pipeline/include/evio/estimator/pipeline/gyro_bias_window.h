@@ -1,0 +1,57 @@
+#pragma once
+/// @file gyro_bias_window.h
+/// The first seconds of a run held back to estimate the gyroscope bias from
+/// the tracks (backend/gyro_bias_from_tracks.h) before the filter sees them:
+/// from the initial state on, the backend's inputs are buffered for
+/// init.gyro_bias_window_s of IMU time; a measurement set at or after each
+/// multiple of init.gyro_bias_keyframe_s becomes a keyframe (its features'
+/// bearings through the camera model). Then the bias is estimated, fused with
+/// the initial state's bias and covariance, and the buffered inputs are
+/// replayed through the filter from the initial state. Memory: one window of
+/// inputs.
+
+#include <optional>
+#include <vector>
+
+#include "evio/core/camera/camera.h"
+#include "evio/estimator/backend/gyro_bias_from_tracks.h"
+#include "evio/estimator/measurements.h"
+#include "evio/estimator/pipeline/backend_input.h"
+
+namespace evio::estimator {
+
+class GyroBiasWindow {
+ public:
+  GyroBiasWindow(double window_s, double keyframe_s, const Camera& camera, const Mat3& R_B_C,
+                 TimeNs time_offset_cam_imu_ns, const GyroBiasFromTracksOptions& solver = {});
+
+  /// Opens the window at the initial state x0 (IMU clock).
+  void open(const ImuState& x0);
+  /// Open and not yet complete: inputs go to add().
+  bool collecting() const { return x0_.has_value() && !complete_; }
+  /// Buffers one input; true once an IMU reading reaches the window's end.
+  bool add(BackendInput in);
+  /// The estimate from what the window holds (prior: x0's bias and the bias
+  /// block of P0); the window is then closed.
+  GyroBiasEstimate estimate(const Mat3& prior_covariance);
+  const ImuState& initialState() const { return *x0_; }
+  /// The buffered inputs in their order, moved out.
+  std::vector<BackendInput> takeInputs() { return std::move(inputs_); }
+
+ private:
+  void addKeyframe(const MeasurementSet& set, TimeNs t_imu_ns);
+
+  double window_s_, keyframe_s_;
+  Camera camera_;
+  Mat3 R_B_C_;
+  TimeNs offset_ns_;
+  GyroBiasFromTracksOptions solver_;
+  std::optional<ImuState> x0_;
+  bool complete_ = false;
+  TimeNs next_keyframe_ns_ = 0;
+  std::vector<BackendInput> inputs_;
+  ImuSamples imu_;
+  std::vector<BearingKeyframe> keyframes_;
+};
+
+}  // namespace evio::estimator

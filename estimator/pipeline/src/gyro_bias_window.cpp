@@ -1,0 +1,68 @@
+#include "evio/estimator/pipeline/gyro_bias_window.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "evio/core/error.h"
+
+namespace evio::estimator {
+
+GyroBiasWindow::GyroBiasWindow(double window_s, double keyframe_s, const Camera& camera, const Mat3& R_B_C,
+                               TimeNs time_offset_cam_imu_ns, const GyroBiasFromTracksOptions& solver)
+    : window_s_(window_s),
+      keyframe_s_(keyframe_s),
+      camera_(camera),
+      R_B_C_(R_B_C),
+      offset_ns_(time_offset_cam_imu_ns),
+      solver_(solver) {}
+
+void GyroBiasWindow::open(const ImuState& x0) {
+  x0_ = x0;
+  complete_ = false;
+  next_keyframe_ns_ = x0.t_ns;
+}
+
+bool GyroBiasWindow::add(BackendInput in) {
+  if (const auto* imu = std::get_if<ImuSample>(&in)) {
+    imu_.push_back(*imu);
+    if (nsToSeconds(imu->t_ns - x0_->t_ns) >= window_s_) complete_ = true;
+  } else if (const auto* set = std::get_if<MeasurementSet>(&in)) {
+    const TimeNs t_imu = set->t_ns + offset_ns_;
+    // Only inside the window and covered by the readings so far (the
+    // backend's own rule: a measurement waits for the IMU to pass it).
+    if (t_imu >= next_keyframe_ns_ && nsToSeconds(t_imu - x0_->t_ns) <= window_s_) {
+      addKeyframe(*set, t_imu);
+      while (next_keyframe_ns_ <= t_imu) next_keyframe_ns_ += secondsToNs(keyframe_s_);
+    }
+  }
+  inputs_.push_back(std::move(in));
+  return complete_;
+}
+
+void GyroBiasWindow::addKeyframe(const MeasurementSet& set, TimeNs t_imu_ns) {
+  BearingKeyframe kf;
+  kf.t_imu_ns = t_imu_ns;
+  for (const FeatureMeasurement& f : set.features) {
+    Vec3 bearing;
+    if (camera_.unproject(f.uv, &bearing)) kf.bearings_C.emplace_back(f.id, bearing.normalized());
+  }
+  std::sort(kf.bearings_C.begin(), kf.bearings_C.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  keyframes_.push_back(std::move(kf));
+}
+
+GyroBiasEstimate GyroBiasWindow::estimate(const Mat3& prior_covariance) {
+  complete_ = true;
+  // Keyframes past the last reading cannot be integrated to.
+  const TimeNs t_last = imu_.empty() ? x0_->t_ns : imu_.back().t_ns;
+  keyframes_.erase(std::remove_if(keyframes_.begin(), keyframes_.end(),
+                                  [&](const BearingKeyframe& k) { return k.t_imu_ns > t_last; }),
+                   keyframes_.end());
+  GyroBiasEstimate e = estimateGyroBiasFromTracks(keyframes_, imu_, R_B_C_, x0_->b_g, prior_covariance, solver_);
+  imu_ = ImuSamples();
+  keyframes_ = std::vector<BearingKeyframe>();
+  return e;
+}
+
+}  // namespace evio::estimator

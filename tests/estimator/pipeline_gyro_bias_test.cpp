@@ -1,0 +1,104 @@
+// The gyroscope bias from the first tracks in the pipeline
+// (pipeline/gyro_bias_window.h) on tiny sequence folders
+// (support/tiny_sequence.h) whose simulated gyroscope has a known bias: the
+// `tracks` method on exact ground-truth tracks with pixel noise.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "evio/core/error.h"
+#include "evio/core/io/tum.h"
+#include "evio/estimator/pipeline/pipeline.h"
+#include "support/tiny_sequence.h"
+#include "temp_dir.h"
+
+namespace evio::estimator {
+namespace {
+
+const Vec3 kTrueBias(0.05, -0.04, 0.03);  // rad/s: 2.9, −2.3, 1.7 °/s
+
+/// The backend on the tracks, started from the ground truth with zero bias
+/// and the defaults' 6°/s, the bias from the first window_s of tracks.
+PipelineOptions windowOptions(double window_s, double noise_px = 0.5) {
+  PipelineOptions o = PipelineOptions::forMethod("tracks");
+  o.init.mode = "groundtruth";
+  o.init.gyro_bias_window_s = window_s;
+  o.tracks.noise_px = noise_px;
+  o.backend.sigma_img_px = 1.0;
+  o.backend.slam_min_depth_m = 1.5;  // the landmarks are 2-5 m away
+  return o;
+}
+
+TEST(PipelineGyroBias, TheWindowFindsTheSimulatedBiasAndTheFilterStartsAtTheInitialTime) {
+  // Exact tracks at 20 Hz of a cloud in front of the camera: the estimate is
+  // within 0.1 °/s of the simulated bias (0.023 °/s measured; the IMU's
+  // white noise and the bias's random walk remain). The filter starts at the
+  // ground-truth time with the window replayed: the first pose is at the
+  // initial time. With 0.5 px or 1 px of noise on the same tracks the
+  // estimate moves 0.54–0.57 °/s (mostly about z) at a stated σ of
+  // 0.02–0.06 °/s: an error not yet explained, docs/algorithms.md.
+  test::TempDir dir;
+  const std::string seq = dir.file("seq"), out = dir.file("out");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  so.gyro_bias_radps = kTrueBias;
+  writeTinySequence(seq, so);
+  const PipelineResult r = runPipeline(seq, windowOptions(1.0, 0.0), out);
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  ASSERT_TRUE(r.gyro_bias.has_value());
+  ASSERT_TRUE(r.gyro_bias->from_tracks);
+  const Vec3 d = r.gyro_bias->b_g - kTrueBias;
+  EXPECT_LT(d.norm(), 0.1 * M_PI / 180.0);
+  ASSERT_TRUE(r.initialization_t_ns.has_value());
+  EXPECT_EQ(*r.initialization_t_ns, 0);
+  const Trajectory est = io::readTum(out + "/trajectory.txt");
+  ASSERT_FALSE(est.empty());
+  EXPECT_LT(est.front().t_ns, secondsToNs(0.1));
+  std::printf("bias from tracks: error %.3f deg/s, sigma %.3f %.3f %.3f deg/s, %d pairs, %d residuals\n",
+              d.norm() * 180.0 / M_PI, std::sqrt(r.gyro_bias->covariance(0, 0)) * 180.0 / M_PI,
+              std::sqrt(r.gyro_bias->covariance(1, 1)) * 180.0 / M_PI,
+              std::sqrt(r.gyro_bias->covariance(2, 2)) * 180.0 / M_PI, r.gyro_bias->pairs, r.gyro_bias->residuals);
+}
+
+TEST(PipelineGyroBias, AWindowLongerThanTheDataClosesAtTheEnd) {
+  // A window of 10 s over 2 s of data: closed at the end of the data with
+  // what it holds, the filter then runs over all of it.
+  test::TempDir dir;
+  const std::string seq = dir.file("seq"), out = dir.file("out");
+  test::TinySequenceOptions so;
+  so.duration_s = 2.0;
+  so.gyro_bias_radps = kTrueBias;
+  writeTinySequence(seq, so);
+  PipelineOptions o = windowOptions(10.0);
+  o.init.gyro_bias_keyframe_s = 0.2;
+  const PipelineResult r = runPipeline(seq, o, out);
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  ASSERT_TRUE(r.gyro_bias.has_value());
+  EXPECT_TRUE(r.gyro_bias->from_tracks);
+  EXPECT_GT(r.counts.poses, 10u);
+  EXPECT_GT(r.counts.measurement_sets, 30u);
+}
+
+/// The message validate() throws, or "" when it does not.
+std::string validationError(const InitOptions& o) {
+  try {
+    o.validate();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(PipelineGyroBias, TheWindowNeedsTheGroundTruthStartAndTwoPairs) {
+  PipelineOptions o = windowOptions(1.0);
+  EXPECT_EQ(validationError(o.init), "");
+  o.init.mode = "static";
+  EXPECT_NE(validationError(o.init).find("gyro_bias_window_s"), std::string::npos);
+  o = windowOptions(1.0);
+  o.init.gyro_bias_keyframe_s = 0.5;
+  EXPECT_NE(validationError(o.init).find("gyro_bias_keyframe_s"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace evio::estimator

@@ -261,6 +261,29 @@ std::vector<Vec3> gridStarts(const std::vector<Pair>& pairs, const ImuSamples& i
   return starts;
 }
 
+/// The covariance's check against the data: the bundle adjustment on each
+/// half of the window (keyframes 0..m and m..K−1, m = K/2) gives b₁ and b₂,
+/// independent estimates if the model holds, so d = b₁ − b₂ has covariance
+/// C₁ + C₂. q = dᵀ(C₁ + C₂)⁻¹d / 3 is then about 1; track errors that are
+/// correlated over the window, which σ²(JᵀJ)⁻¹ takes as white, make it
+/// larger. Returns max(1, q) (1 when a half cannot be solved), q in *q_out.
+double splitHalfInflation(const std::vector<BearingKeyframe>& keyframes, const ImuSamples& imu, const Mat3& R_B_C,
+                          const Vec3& b, const GyroBiasFromTracksOptions& options, double* q_out) {
+  *q_out = 0.0;
+  const std::size_t m = keyframes.size() / 2;
+  if (m < 3 || keyframes.size() - m < 3) return 1.0;
+  const std::vector<BearingKeyframe> first(keyframes.begin(), keyframes.begin() + static_cast<std::ptrdiff_t>(m + 1));
+  const std::vector<BearingKeyframe> second(keyframes.begin() + static_cast<std::ptrdiff_t>(m), keyframes.end());
+  const BundleBiasEstimate e1 = refineGyroBiasByBundleAdjustment(first, imu, R_B_C, b, options);
+  const BundleBiasEstimate e2 = refineGyroBiasByBundleAdjustment(second, imu, R_B_C, b, options);
+  if (!e1.valid || !e2.valid) return 1.0;
+  const Vec3 d = e1.b_g - e2.b_g;
+  const double q = d.dot((e1.covariance + e2.covariance).inverse() * d) / 3.0;
+  if (!std::isfinite(q)) return 1.0;
+  *q_out = q;
+  return std::max(1.0, q);
+}
+
 }  // namespace
 
 Mat3 integrateGyroRotation(const ImuSamples& imu, TimeNs t0_ns, TimeNs t1_ns, const Vec3& b_g) {
@@ -318,8 +341,19 @@ GyroBiasEstimate estimateGyroBiasFromTracks(const std::vector<BearingKeyframe>& 
   // Each pair's direction t takes two degrees of freedom, the bias three.
   const int dof = static_cast<int>(lin.r.size()) - 3 - 2 * static_cast<int>(pairs.size());
   if (dof < 1 || !b.allFinite()) return out;
-  const double sigma2 = lin.r.squaredNorm() / dof;
-  const Mat3 data_information = lin.J.transpose() * lin.J / sigma2;
+  double sigma2 = lin.r.squaredNorm() / dof;
+  Mat3 data_covariance = sigma2 * (lin.J.transpose() * lin.J).inverse();
+  if (options.bundle_adjustment) {
+    const BundleBiasEstimate ba = refineGyroBiasByBundleAdjustment(keyframes, imu, R_B_C, b, options);
+    if (ba.valid && ba.b_g.allFinite()) {
+      b = ba.b_g;
+      data_covariance = ba.covariance;
+      if (options.split_half_check)
+        data_covariance *= splitHalfInflation(keyframes, imu, R_B_C, b, options, &out.split_half_q);
+      sigma2 = ba.bearing_sigma_rad * ba.bearing_sigma_rad;
+    }
+  }
+  const Mat3 data_information = data_covariance.inverse();
   const Mat3 prior_information = prior_covariance.inverse();
   const Mat3 posterior = (data_information + prior_information).inverse();
   out.b_g = posterior * (data_information * b + prior_information * prior_b_g);
@@ -329,7 +363,7 @@ GyroBiasEstimate estimateGyroBiasFromTracks(const std::vector<BearingKeyframe>& 
   out.residuals = static_cast<int>(lin.r.size());
   out.bearing_sigma_rad = std::sqrt(sigma2);
   out.data_b_g = b;
-  out.data_covariance = data_information.inverse();
+  out.data_covariance = data_covariance;
   return out;
 }
 

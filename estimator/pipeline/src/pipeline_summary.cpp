@@ -38,6 +38,7 @@ void emitGyroBias(YAML::Emitter& out, const GyroBiasEstimate& e) {
     out << YAML::Key << "residuals" << YAML::Value << e.residuals;
     out << YAML::Key << "outliers" << YAML::Value << e.outliers;
     emitSeconds(out, "bearing_sigma_rad", e.bearing_sigma_rad);
+    emitSeconds(out, "split_half_q", e.split_half_q);
   }
   out << YAML::EndMap;
 }

@@ -121,6 +121,12 @@ TEST(GyroBiasFromTracks, ExactBearingsGiveTheTrueBias) {
     EXPECT_EQ(e.pairs, 5);
     EXPECT_LT((e.data_b_g - kBias).norm(), 1e-6);
     EXPECT_LT((e.b_g - kBias).norm(), 1e-6);
+    // The bundle adjustment on its own, from the two-view result: it runs
+    // (no fallback) also when the camera only turns and depths are free.
+    const BundleBiasEstimate ba =
+        refineGyroBiasByBundleAdjustment(kfs, rig.imu, rig.R_B_C, kBias + Vec3(0.01, -0.01, 0.01));
+    ASSERT_TRUE(ba.valid);
+    EXPECT_LT((ba.b_g - kBias).norm(), 1e-6);
   }
 }
 

@@ -58,7 +58,9 @@ std::vector<Vec3> normals(const Pair& p, const Mat3& R_Ci_Cj) {
   return n;
 }
 
+/// The median (0 for no values).
 double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
@@ -262,8 +264,9 @@ std::vector<Vec3> gridStarts(const std::vector<Pair>& pairs, const ImuSamples& i
 }
 
 /// The covariance's check against the data: the bundle adjustment on each
-/// half of the window (keyframes 0..m and m..K−1, m = K/2) gives b₁ and b₂,
-/// independent estimates if the model holds, so d = b₁ − b₂ has covariance
+/// half of the window (keyframes 0..m−1 and m..K−1, m = K/2, no keyframe in
+/// both) gives b₁ and b₂, independent estimates for white track errors, so
+/// d = b₁ − b₂ has covariance
 /// C₁ + C₂. q = dᵀ(C₁ + C₂)⁻¹d / 3 is then about 1; track errors that are
 /// correlated over the window, which σ²(JᵀJ)⁻¹ takes as white, make it
 /// larger. Returns max(1, q) (1 when a half cannot be solved), q in *q_out.
@@ -272,7 +275,7 @@ double splitHalfInflation(const std::vector<BearingKeyframe>& keyframes, const I
   *q_out = 0.0;
   const std::size_t m = keyframes.size() / 2;
   if (m < 3 || keyframes.size() - m < 3) return 1.0;
-  const std::vector<BearingKeyframe> first(keyframes.begin(), keyframes.begin() + static_cast<std::ptrdiff_t>(m + 1));
+  const std::vector<BearingKeyframe> first(keyframes.begin(), keyframes.begin() + static_cast<std::ptrdiff_t>(m));
   const std::vector<BearingKeyframe> second(keyframes.begin() + static_cast<std::ptrdiff_t>(m), keyframes.end());
   const BundleBiasEstimate e1 = refineGyroBiasByBundleAdjustment(first, imu, R_B_C, b, options);
   const BundleBiasEstimate e2 = refineGyroBiasByBundleAdjustment(second, imu, R_B_C, b, options);
@@ -336,10 +339,19 @@ GyroBiasEstimate estimateGyroBiasFromTracks(const std::vector<BearingKeyframe>& 
   for (std::size_t p = 0; p < pairs.size(); ++p)
     for (std::size_t k = 0; k < pairs[p].features.size(); ++k, ++i)
       if (std::abs(lin.r(i)) > gate) kept[p][k] = false, ++out.outliers;
+  // A pair left with fewer than min_features residuals is dropped whole.
+  int pairs_used = 0;
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    if (std::count(kept[p].begin(), kept[p].end(), true) >= options.min_features)
+      ++pairs_used;
+    else
+      std::fill(kept[p].begin(), kept[p].end(), false);
+  }
+  if (pairs_used < 2) return out;
   lin = solve(pairs, kept, imu, R_B_C, options.max_iterations, false, &b);
 
   // Each pair's direction t takes two degrees of freedom, the bias three.
-  const int dof = static_cast<int>(lin.r.size()) - 3 - 2 * static_cast<int>(pairs.size());
+  const int dof = static_cast<int>(lin.r.size()) - 3 - 2 * pairs_used;
   if (dof < 1 || !b.allFinite()) return out;
   double sigma2 = lin.r.squaredNorm() / dof;
   Mat3 data_covariance = sigma2 * (lin.J.transpose() * lin.J).inverse();
@@ -356,6 +368,12 @@ GyroBiasEstimate estimateGyroBiasFromTracks(const std::vector<BearingKeyframe>& 
   const Mat3 data_information = data_covariance.inverse();
   const Mat3 prior_information = prior_covariance.inverse();
   const Mat3 posterior = (data_information + prior_information).inverse();
+  // A degenerate window (no residual spread, a singular information) leaves
+  // the prior standing rather than giving the filter a covariance it cannot take.
+  if (!data_information.allFinite() || !posterior.allFinite() ||
+      Eigen::SelfAdjointEigenSolver<Mat3>(0.5 * (posterior + posterior.transpose()), Eigen::EigenvaluesOnly)
+              .eigenvalues()(0) <= 0.0)
+    return out;
   out.b_g = posterior * (data_information * b + prior_information * prior_b_g);
   out.covariance = 0.5 * (posterior + posterior.transpose());
   out.from_tracks = true;

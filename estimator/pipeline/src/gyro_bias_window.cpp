@@ -29,12 +29,14 @@ bool GyroBiasWindow::add(BackendInput in) {
     if (nsToSeconds(imu->t_ns - x0_->t_ns) >= window_s_) complete_ = true;
   } else if (const auto* set = std::get_if<MeasurementSet>(&in)) {
     const TimeNs t_imu = set->t_ns + offset_ns_;
-    // Only inside the window and covered by the readings so far (the
-    // backend's own rule: a measurement waits for the IMU to pass it).
-    if (t_imu >= next_keyframe_ns_ && nsToSeconds(t_imu - x0_->t_ns) <= window_s_) {
+    if (nsToSeconds(t_imu - x0_->t_ns) > window_s_) {
+      complete_ = true;  // the data passed the window's end without an IMU reading
+    } else if (t_imu >= next_keyframe_ns_) {
       addKeyframe(*set, t_imu);
       while (next_keyframe_ns_ <= t_imu) next_keyframe_ns_ += secondsToNs(keyframe_s_);
     }
+  } else if (nsToSeconds(std::get<RangeMeasurement>(in).t_ns + offset_ns_ - x0_->t_ns) > window_s_) {
+    complete_ = true;
   }
   inputs_.push_back(std::move(in));
   return complete_;
@@ -45,7 +47,9 @@ void GyroBiasWindow::addKeyframe(const MeasurementSet& set, TimeNs t_imu_ns) {
   kf.t_imu_ns = t_imu_ns;
   for (const FeatureMeasurement& f : set.features) {
     Vec3 bearing;
-    if (camera_.unproject(f.uv, &bearing)) kf.bearings_C.emplace_back(f.id, bearing.normalized());
+    // A feature that is not informative repeats an earlier position (no new
+    // track point): it does not show where the feature is at this time.
+    if (f.informative && camera_.unproject(f.uv, &bearing)) kf.bearings_C.emplace_back(f.id, bearing.normalized());
   }
   std::sort(kf.bearings_C.begin(), kf.bearings_C.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -54,10 +58,12 @@ void GyroBiasWindow::addKeyframe(const MeasurementSet& set, TimeNs t_imu_ns) {
 
 GyroBiasEstimate GyroBiasWindow::estimate(const Mat3& prior_covariance) {
   complete_ = true;
-  // Keyframes past the last reading cannot be integrated to.
+  // Only keyframes the readings cover can be integrated between (x0 may lie
+  // up to one IMU period before the first reading the window holds).
+  const TimeNs t_first = imu_.empty() ? x0_->t_ns : imu_.front().t_ns;
   const TimeNs t_last = imu_.empty() ? x0_->t_ns : imu_.back().t_ns;
   keyframes_.erase(std::remove_if(keyframes_.begin(), keyframes_.end(),
-                                  [&](const BearingKeyframe& k) { return k.t_imu_ns > t_last; }),
+                                  [&](const BearingKeyframe& k) { return k.t_imu_ns < t_first || k.t_imu_ns > t_last; }),
                    keyframes_.end());
   GyroBiasEstimate e = estimateGyroBiasFromTracks(keyframes_, imu_, R_B_C_, x0_->b_g, prior_covariance, solver_);
   imu_ = ImuSamples();

@@ -130,9 +130,11 @@ void BackendStage::finish(std::vector<Estimate>& out) {
 void BackendStage::closeWindow(std::vector<Estimate>& out) {
   Eigen::Matrix<double, 15, 15> P0 = backend_.initialCovariance();
   gyro_bias_ = window_->estimate(P0.block<3, 3>(kIdxBg, kIdxBg));
+  // The estimate moves the bias's mean, the point the filter linearises at;
+  // its covariance stays the prior's, since the filter is about to take the
+  // window's tracks again (told both, it would count them twice).
   ImuState x0 = window_->initialState();
   x0.b_g = gyro_bias_->b_g;
-  P0.block<3, 3>(kIdxBg, kIdxBg) = gyro_bias_->covariance;
   backend_.initialize(x0, P0);
   for (BackendInput& in : window_->takeInputs()) feed(in, out);
 }

@@ -43,7 +43,7 @@
 /// outlier_sigmas · σ are dropped once and the solve re-run.
 ///
 /// That two-view estimate is biased under bearing noise along the same
-/// valley (1.9 °/s mean error at 0.5 px on a narrow view of a wall), so it
+/// valley (1.88 °/s mean error at 0.5 px on a narrow view of a wall), so it
 /// only starts a bundle adjustment of all keyframes
 /// (refineGyroBiasByBundleAdjustment: reprojection errors, camera centres and
 /// points free, rotations from the gyroscope), which gives the tracks'
@@ -122,8 +122,9 @@ struct BundleBiasEstimate {
 /// camera centres and anchored inverse depths free, the reprojection error
 /// of every observation in angles. The two-view cost above is biased along
 /// the rotation–translation valley under bearing noise (a narrow view of a
-/// wall: 1.4 °/s at 0.5 px); this is not, and starts in the valley's right
-/// part from the two-view estimate. Invalid with fewer than min_features
+/// wall: 1.88 °/s mean error at 0.5 px, 0.37 °/s after this); this is
+/// nearly not, and starts in the valley's right part from the two-view
+/// estimate. Invalid with fewer than min_features
 /// features at min_keyframes_per_feature keyframes.
 BundleBiasEstimate refineGyroBiasByBundleAdjustment(const std::vector<BearingKeyframe>& keyframes,
                                                     const ImuSamples& imu, const Mat3& R_B_C, const Vec3& b_start,

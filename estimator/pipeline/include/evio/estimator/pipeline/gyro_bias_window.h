@@ -2,13 +2,15 @@
 /// @file gyro_bias_window.h
 /// The first seconds of a run held back to estimate the gyroscope bias from
 /// the tracks (backend/gyro_bias_from_tracks.h) before the filter sees them:
-/// from the initial state on, the backend's inputs are buffered for
-/// init.gyro_bias_window_s of IMU time; a measurement set at or after each
-/// multiple of init.gyro_bias_keyframe_s becomes a keyframe (its features'
-/// bearings through the camera model). Then the bias is estimated, fused with
-/// the initial state's bias and covariance, and the buffered inputs are
-/// replayed through the filter from the initial state. Memory: one window of
-/// inputs.
+/// from the initial state on, the backend's inputs are buffered until the
+/// data pass init.gyro_bias_window_s of IMU time (or end); the first
+/// measurement set at or after each multiple of init.gyro_bias_keyframe_s
+/// becomes a keyframe (the bearings of its informative features through the
+/// camera model). Then the bias is estimated and fused with the initial
+/// state's, and the buffered inputs are replayed through the filter from the
+/// initial state with that bias as its mean; the bias's covariance stays the
+/// prior's, because the replay gives the filter the window's tracks again.
+/// Memory: one window of inputs.
 
 #include <optional>
 #include <vector>

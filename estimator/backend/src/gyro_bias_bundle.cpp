@@ -23,6 +23,7 @@
 
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/gyro_bias_from_tracks.h"
+#include "robust_fit.h"
 
 namespace evio::estimator {
 namespace {
@@ -218,23 +219,21 @@ State step(const Normal& N, const State& s, double lambda, Eigen::MatrixXd* S_ou
   return next;
 }
 
+/// The robust σ of the residuals the mask keeps (robust_fit.h).
 double robustSpread(const Eigen::VectorXd& r, const Eigen::VectorXd& kept) {
   std::vector<double> a;
   for (Eigen::Index i = 0; i < r.size(); ++i)
     if (kept(i) > 0.0) a.push_back(std::abs(r(i)));
-  if (a.empty()) return 0.0;
-  const auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
-  std::nth_element(a.begin(), mid, a.end());
-  return 1.4826 * *mid;
+  return robust::sigmaOfAbsolute(std::move(a));
 }
 
-/// Huber weights at 1.345 robust σ over the kept residuals (the mask's 0s stay 0).
-Eigen::VectorXd weights(const Eigen::VectorXd& r, const Eigen::VectorXd& kept, bool robust) {
+/// Huber's weights over the kept residuals (the mask's 0s stay 0).
+Eigen::VectorXd weights(const Eigen::VectorXd& r, const Eigen::VectorXd& kept, bool huber) {
   Eigen::VectorXd w = kept;
-  if (!robust) return w;
-  const double c = 1.345 * robustSpread(r, kept);
+  if (!huber) return w;
+  const double c = robust::kHuberSigmas * robustSpread(r, kept);
   for (Eigen::Index i = 0; i < r.size(); ++i)
-    if (kept(i) > 0.0 && std::abs(r(i)) > c && c > 0.0) w(i) = c / std::abs(r(i));
+    if (kept(i) > 0.0) w(i) = robust::huberWeight(r(i), c);
   return w;
 }
 
@@ -242,11 +241,11 @@ double cost(const Eigen::VectorXd& r, const Eigen::VectorXd& w) { return (w.arra
 
 /// Levenberg–Marquardt from s; each iteration's weights from its start.
 void solve(const Problem& p, const ImuSamples& imu, const Mat3& R_B_C, const Eigen::VectorXd& kept,
-           int max_iterations, bool robust, State* s) {
+           int max_iterations, bool huber, State* s) {
   Eigen::VectorXd r = residuals(p, imu, R_B_C, *s);
   double lambda = 1e-3;
   for (int it = 0; it < max_iterations; ++it) {
-    const Eigen::VectorXd w = weights(r, kept, robust);
+    const Eigen::VectorXd w = weights(r, kept, huber);
     const Normal N = normalEquations(p, imu, R_B_C, *s, r, w);
     const double before = cost(r, w);
     bool accepted = false;

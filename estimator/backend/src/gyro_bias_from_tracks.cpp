@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "evio/core/so3.h"
+#include "robust_fit.h"
 
 namespace evio::estimator {
 namespace {
@@ -58,14 +59,6 @@ std::vector<Vec3> normals(const Pair& p, const Mat3& R_Ci_Cj) {
   return n;
 }
 
-/// The median (0 for no values).
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 /// The unit t minimising Σ w_k (tᵀ n_k)² over the kept normals: the
 /// eigenvector of the smallest eigenvalue of Σ w_k n_k n_kᵀ, its sign that of
 /// `near`.
@@ -92,11 +85,8 @@ std::vector<double> directionWeights(const std::vector<Vec3>& n, const std::vect
     std::vector<double> a;
     for (std::size_t k = 0; k < n.size(); ++k)
       if (kept[k]) a.push_back(std::abs(t.dot(n[k])));
-    const double c = 1.345 * 1.4826 * median(a);
-    for (std::size_t k = 0; k < n.size(); ++k) {
-      const double r = std::abs(t.dot(n[k]));
-      w[k] = r > c && c > 0.0 ? c / r : 1.0;
-    }
+    const double c = robust::kHuberSigmas * robust::kMadToSigma * robust::median(std::move(a));
+    for (std::size_t k = 0; k < n.size(); ++k) w[k] = robust::huberWeight(t.dot(n[k]), c);
   }
   return w;
 }
@@ -174,11 +164,11 @@ Linearization linearize(const std::vector<Pair>& pairs, const Mask& kept, const 
   return lin;
 }
 
-/// The robust spread of the residuals: 1.4826 · median |r|.
+/// The robust σ of the residuals (robust_fit.h).
 double robustSigma(const Eigen::VectorXd& r) {
   std::vector<double> a(static_cast<std::size_t>(r.size()));
   for (Eigen::Index i = 0; i < r.size(); ++i) a[static_cast<std::size_t>(i)] = std::abs(r(i));
-  return 1.4826 * median(std::move(a));
+  return robust::sigmaOfAbsolute(std::move(a));
 }
 
 /// Gauss–Newton from b over the kept residuals; returns the final
@@ -186,13 +176,13 @@ double robustSigma(const Eigen::VectorXd& r) {
 /// weights at 1.345 robust σ, so a few wrong correspondences cannot drag b
 /// away before they are gated; otherwise plain least squares.
 Linearization solve(const std::vector<Pair>& pairs, const Mask& kept, const ImuSamples& imu, const Mat3& R_B_C,
-                    int max_iterations, bool robust, Vec3* b) {
+                    int max_iterations, bool huber, Vec3* b) {
   Linearization lin = linearize(pairs, kept, imu, R_B_C, *b);
   for (int it = 0; it < max_iterations; ++it) {
     Eigen::VectorXd w = Eigen::VectorXd::Ones(lin.r.size());
-    if (robust) {
-      const double c = 1.345 * robustSigma(lin.r);
-      for (Eigen::Index i = 0; i < w.size(); ++i) w(i) = std::abs(lin.r(i)) > c ? c / std::abs(lin.r(i)) : 1.0;
+    if (huber) {
+      const double c = robust::kHuberSigmas * robustSigma(lin.r);
+      for (Eigen::Index i = 0; i < w.size(); ++i) w(i) = robust::huberWeight(lin.r(i), c);
     }
     const Mat3 H = lin.J.transpose() * w.asDiagonal() * lin.J;
     const Vec3 step = -H.ldlt().solve(lin.J.transpose() * w.asDiagonal() * lin.r);

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -92,7 +93,28 @@ bool isChildStaging(const char* name, const char* base, std::size_t base_len) {
   return true;
 }
 
-/// Removes the "<path>.staging.<pid>" folders beside `slot.path` (system calls only).
+/// The pid at the end of a child's staging name "<base>.staging.<pid>".
+pid_t stagingPid(const char* name, std::size_t base_len) {
+  pid_t pid = 0;
+  for (const char* c = name + base_len + std::strlen(".staging."); *c != '\0'; ++c) pid = pid * 10 + (*c - '0');
+  return pid;
+}
+
+/// Stops the child that writes a staging folder before the folder goes:
+/// a child still running can create a file in it while it is being removed
+/// and leave it behind (the fault suite saw imu.txt.tmp.* left so under
+/// load). Only a running child of this process is stopped (waitpid says
+/// so: a pid that is not our child, or one already reaped, is left alone).
+/// System calls only.
+void stopChild(pid_t pid) {
+  int status = 0;
+  if (pid <= 0 || ::waitpid(pid, &status, WNOHANG) != 0) return;
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+}
+
+/// Removes the "<path>.staging.<pid>" folders beside `slot.path`, each after
+/// stopping its child (system calls only).
 void removeChildStaging(const Slot& slot) {
   char dir[kPathMax];
   const std::size_t n = slot.name_at;
@@ -113,7 +135,9 @@ void removeChildStaging(const Slot& slot) {
     for (long off = 0; off < got;) {
       const auto* d = reinterpret_cast<const struct dirent64*>(buf + off);
       off += d->d_reclen;
-      if (isChildStaging(d->d_name, base, base_len)) removeTreeAt(fd, d->d_name, 0);
+      if (!isChildStaging(d->d_name, base, base_len)) continue;
+      stopChild(stagingPid(d->d_name, base_len));
+      removeTreeAt(fd, d->d_name, 0);
     }
   }
   ::close(fd);

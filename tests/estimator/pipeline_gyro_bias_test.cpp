@@ -63,6 +63,41 @@ TEST(PipelineGyroBias, TheWindowFindsTheSimulatedBiasAndTheFilterStartsAtTheInit
               std::sqrt(r.gyro_bias->covariance(2, 2)) * 180.0 / M_PI, r.gyro_bias->pairs, r.gyro_bias->residuals);
 }
 
+TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
+  // The flight preset's first 2 s on the ground: the window's IMU is at rest,
+  // so its mean rate gives the simulated 4.1 °/s bias to its white noise,
+  // σ_g/√T (the tiny rig's σ_g = 2e-4 rad/s/√Hz, T = 1 s: 0.011 °/s), and the
+  // filter starts with that covariance, not the prior's 6 °/s. With the rest
+  // test off the same window goes to the tracks (a camera at rest shows a
+  // rotation error too: the tracks find the bias, and the filter keeps the
+  // prior's σ, since it takes the tracks again).
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  so.gyro_bias_radps = kTrueBias;
+  so.trajectory_preset = "flight.yaml";
+  writeTinySequence(seq, so);
+  const PipelineResult r = runPipeline(seq, windowOptions(1.0), dir.file("out"));
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  ASSERT_TRUE(r.gyro_bias.has_value());
+  EXPECT_TRUE(r.gyro_bias->at_rest);
+  EXPECT_FALSE(r.gyro_bias->from_tracks);
+  EXPECT_NEAR(r.gyro_bias->rest_s, 1.0, 0.01);
+  const Vec3 d = r.gyro_bias->b_g - kTrueBias;
+  const double sigma = std::sqrt(r.gyro_bias->covariance(0, 0));
+  EXPECT_LT(sigma, 0.02 * M_PI / 180.0);
+  EXPECT_LT(d.dot(r.gyro_bias->covariance.inverse() * d), 16.3);  // χ²₃ 99.9 %
+  std::printf("bias at rest: error %.4f deg/s, sigma %.4f deg/s\n", d.norm() * 180.0 / M_PI, sigma * 180.0 / M_PI);
+
+  PipelineOptions off = windowOptions(1.0);
+  off.init.gyro_bias_window_rest = false;
+  const PipelineResult r_off = runPipeline(seq, off, dir.file("out_off"));
+  ASSERT_TRUE(r_off.gyro_bias.has_value());
+  EXPECT_FALSE(r_off.gyro_bias->at_rest);
+  EXPECT_TRUE(r_off.gyro_bias->from_tracks);
+}
+
 TEST(PipelineGyroBias, AWindowLongerThanTheDataClosesAtTheEnd) {
   // A window of 10 s over 2 s of data: closed at the end of the data with
   // what it holds, the filter then runs over all of it.

@@ -2,6 +2,10 @@
 
 #include <cmath>
 
+#include <Eigen/Cholesky>
+
+#include "evio/core/so3.h"
+
 namespace evio::estimator {
 
 std::optional<StaticInitResult> staticInitialize(const ImuSamples& samples, double gravity_mps2,
@@ -42,6 +46,149 @@ std::optional<StaticInitResult> staticInitialize(const ImuSamples& samples, doub
   out.state.b_g = gyro_mean;
   out.state.b_a.setZero();
   return out;
+}
+
+std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double gravity_mps2, double max_acc_std_mps2,
+                                               double max_gyro_std_radps, const ImuNoiseDensities& noise) {
+  if (samples.size() < 2) return std::nullopt;
+  RestMeasurement m;
+  m.t0_ns = samples.front().t_ns;
+  m.t1_ns = samples.back().t_ns;
+  const double T = m.durationS();
+  if (!(T > 0.0)) return std::nullopt;
+  // The bounds are the spread motion may add: the white noise's own spread
+  // per reading, σ √f at f readings per second, is added in quadrature, so
+  // that a still IMU passes at any rate (1 kHz: 0.14 m/s², 0.006 rad/s at
+  // the DAVIS240's densities).
+  const double f = static_cast<double>(samples.size() - 1) / T;
+  const auto bound = [f](double motion, double density) { return std::sqrt(motion * motion + density * density * f); };
+  const std::optional<StaticInitResult> still =
+      staticInitialize(samples, gravity_mps2, bound(max_acc_std_mps2, noise.accelerometer_noise_density),
+                       bound(max_gyro_std_radps, noise.gyroscope_noise_density));
+  if (!still) return std::nullopt;
+  for (const ImuSample& s : samples) m.mean_acc += s.acc_B;
+  m.mean_acc /= static_cast<double>(samples.size());
+  m.mean_gyro = still->state.b_g;
+  const auto variance = [T](double density, double random_walk) {
+    return density * density / T + random_walk * random_walk * T / 3.0;
+  };
+  m.gyro_variance = variance(noise.gyroscope_noise_density, noise.gyroscope_random_walk);
+  m.acc_variance = variance(noise.accelerometer_noise_density, noise.accelerometer_random_walk);
+  return m;
+}
+
+namespace {
+
+/// x0 ⊞ dx in the filter's convention (filter_state.cpp FilterState::correct).
+ImuState boxPlus(const ImuState& x0, const Eigen::Matrix<double, 15, 1>& dx) {
+  ImuState x = x0;
+  x.p_W_B += dx.segment<3>(kIdxP);
+  x.v_W += dx.segment<3>(kIdxV);
+  x.q_W_B = (x0.q_W_B * so3::expQuat(dx.segment<3>(kIdxTheta))).normalized();
+  x.b_g += dx.segment<3>(kIdxBg);
+  x.b_a += dx.segment<3>(kIdxBa);
+  return x;
+}
+
+/// The covariance of the force's second-order term in the attitude error e,
+/// Exp(−e) f ≈ f − e × f + q(e) with q(e) = ½ e × (e × f): a tilt lowers
+/// the force along itself by g |e⊥|²/2, and a yaw error turns the tilt's
+/// term sideways, by g ψ θ. No linearisation carries either; with the
+/// prior's σ of 3° they reach 0.03 m/s², seven times a second's mean noise.
+/// q_k = ½ eᵀ B_k e with B_k = ½ (u_k fᵀ + f u_kᵀ) − f_k I (u_k the k-th
+/// axis), and for e ~ N(0, P_θ) (Isserlis) Cov(q_k, q_l) = ½ tr(B_k P_θ B_l P_θ).
+Mat3 secondOrderForceCovariance(const ImuState& x, const Mat3& P_theta, double gravity_mps2) {
+  const Vec3 f = x.q_W_B.toRotationMatrix().transpose() * Vec3(0.0, 0.0, gravity_mps2);
+  Mat3 BP[3];
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 u = Vec3::Unit(k);
+    const Mat3 B = 0.5 * (u * f.transpose() + f * u.transpose()) - f(k) * Mat3::Identity();
+    BP[k] = B * P_theta;
+  }
+  Mat3 cov;
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) cov(k, l) = 0.5 * (BP[k] * BP[l]).trace();
+  return cov;
+}
+
+/// x ⊟ x0: the error state taking x0 to x.
+Eigen::Matrix<double, 15, 1> boxMinus(const ImuState& x, const ImuState& x0) {
+  Eigen::Matrix<double, 15, 1> d;
+  d.segment<3>(kIdxP) = x.p_W_B - x0.p_W_B;
+  d.segment<3>(kIdxV) = x.v_W - x0.v_W;
+  d.segment<3>(kIdxTheta) = so3::log(x0.q_W_B.toRotationMatrix().transpose() * x.q_W_B.toRotationMatrix());
+  d.segment<3>(kIdxBg) = x.b_g - x0.b_g;
+  d.segment<3>(kIdxBa) = x.b_a - x0.b_a;
+  return d;
+}
+
+}  // namespace
+
+namespace {
+
+using Matrix15 = Eigen::Matrix<double, 15, 15>;
+
+/// The iterated update of (x, P) by the rest measurement with noise R.
+/// Iterated because the force is quadratic in the attitude error (its
+/// vertical part falls by g θ²/2, 0.013 m/s² at 3°, three times the noise of
+/// a second's mean): Gauss–Newton on prior plus measurement, relinearised at
+/// each iterate until the step is below 1e-12; then the Joseph form at the
+/// last linearisation (the prior is wide, the rest tight: it keeps P
+/// symmetric and positive semi-definite).
+bool iteratedRestUpdate(const RestMeasurement& rest, double gravity_mps2, const Eigen::Matrix<double, 6, 6>& R,
+                        ImuState* x, Matrix15* P) {
+  const ImuState x0 = *x;
+  ImuState xi = x0;
+  Eigen::Matrix<double, 6, 15> H;
+  Eigen::Matrix<double, 15, 6> K;
+  for (int it = 0; it < 10; ++it) {
+    const Vec3 f_B = xi.q_W_B.toRotationMatrix().transpose() * Vec3(0.0, 0.0, gravity_mps2);  // force at rest
+    H.setZero();
+    H.block<3, 3>(0, kIdxBg).setIdentity();
+    H.block<3, 3>(3, kIdxTheta) = so3::hat(f_B);
+    H.block<3, 3>(3, kIdxBa).setIdentity();
+    Eigen::Matrix<double, 6, 1> r;
+    r.head<3>() = rest.mean_gyro - xi.b_g;
+    r.tail<3>() = rest.mean_acc - (f_B + xi.b_a);
+    const Eigen::Matrix<double, 15, 1> di = boxMinus(xi, x0);
+    const Eigen::Matrix<double, 15, 6> PHt = *P * H.transpose();
+    const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(H * PHt + R);
+    if (llt.info() != Eigen::Success) return false;
+    K = llt.solve(PHt.transpose()).transpose();
+    const Eigen::Matrix<double, 15, 1> dx = K * (r + H * di);
+    const double step = (dx - di).norm();
+    xi = boxPlus(x0, dx);
+    if (step < 1e-12) break;
+  }
+  const Matrix15 IKH = Matrix15::Identity() - K * H;
+  const Matrix15 Pn = IKH * *P * IKH.transpose() + K * R * K.transpose();
+  *P = 0.5 * (Pn + Pn.transpose());
+  *x = xi;
+  return true;
+}
+
+}  // namespace
+
+bool applyRestMeasurement(const RestMeasurement& rest, double gravity_mps2, ImuState* x, Matrix15* P) {
+  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
+  R.diagonal().head<3>().setConstant(rest.gyro_variance);
+  R.diagonal().tail<3>().setConstant(rest.acc_variance);
+  // The second-order term's spread is set by the attitude error that is left
+  // at the solution: a first update with the prior's, then the update again
+  // from the prior with the attitude covariance that one left.
+  ImuState x1 = *x;
+  Matrix15 P1 = *P;
+  Eigen::Matrix<double, 6, 6> R1 = R;
+  R1.block<3, 3>(3, 3) += secondOrderForceCovariance(*x, P->block<3, 3>(kIdxTheta, kIdxTheta), gravity_mps2);
+  if (!iteratedRestUpdate(rest, gravity_mps2, R1, &x1, &P1)) return false;
+  Eigen::Matrix<double, 6, 6> R2 = R;
+  R2.block<3, 3>(3, 3) += secondOrderForceCovariance(x1, P1.block<3, 3>(kIdxTheta, kIdxTheta), gravity_mps2);
+  ImuState x2 = *x;
+  Matrix15 P2 = *P;
+  if (!iteratedRestUpdate(rest, gravity_mps2, R2, &x2, &P2)) return false;
+  *x = x2;
+  *P = P2;
+  return true;
 }
 
 }  // namespace evio::estimator

@@ -9,12 +9,14 @@
 namespace evio::estimator {
 
 GyroBiasWindow::GyroBiasWindow(double window_s, double keyframe_s, const Camera& camera, const Mat3& R_B_C,
-                               TimeNs time_offset_cam_imu_ns, const GyroBiasFromTracksOptions& solver)
+                               TimeNs time_offset_cam_imu_ns, const WindowRestTest& rest_test,
+                               const GyroBiasFromTracksOptions& solver)
     : window_s_(window_s),
       keyframe_s_(keyframe_s),
       camera_(camera),
       R_B_C_(R_B_C),
       offset_ns_(time_offset_cam_imu_ns),
+      rest_test_(rest_test),
       solver_(solver) {}
 
 void GyroBiasWindow::open(const ImuState& x0) {
@@ -65,7 +67,18 @@ GyroBiasEstimate GyroBiasWindow::estimate(const Mat3& prior_covariance) {
   keyframes_.erase(std::remove_if(keyframes_.begin(), keyframes_.end(),
                                   [&](const BearingKeyframe& k) { return k.t_imu_ns < t_first || k.t_imu_ns > t_last; }),
                    keyframes_.end());
-  GyroBiasEstimate e = estimateGyroBiasFromTracks(keyframes_, imu_, R_B_C_, x0_->b_g, prior_covariance, solver_);
+  if (rest_test_.enabled)
+    rest_ = restMeasurement(imu_, rest_test_.gravity_mps2, rest_test_.max_acc_std_mps2,
+                            rest_test_.max_gyro_std_radps, rest_test_.noise);
+  GyroBiasEstimate e;
+  if (rest_) {
+    e.b_g = x0_->b_g;
+    e.covariance = prior_covariance;
+    e.at_rest = true;
+    e.rest_s = rest_->durationS();
+  } else {
+    e = estimateGyroBiasFromTracks(keyframes_, imu_, R_B_C_, x0_->b_g, prior_covariance, solver_);
+  }
   imu_ = ImuSamples();
   keyframes_ = std::vector<BearingKeyframe>();
   return e;

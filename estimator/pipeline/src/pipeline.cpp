@@ -272,9 +272,16 @@ void PipelineRun::setupStages() {
     result_.notes.push_back("static initialisation: position and yaw zero, the estimate needs alignment");
   }
   std::optional<GyroBiasWindow> gyro_bias_window;
-  if (options_.init.gyro_bias_window_s > 0.0)
+  if (options_.init.gyro_bias_window_s > 0.0) {
+    WindowRestTest rest;
+    rest.enabled = options_.init.gyro_bias_window_rest;
+    rest.gravity_mps2 = rig_.rig.gravity_m_s2;
+    rest.max_acc_std_mps2 = options_.backend.static_max_acc_std_mps2;
+    rest.max_gyro_std_radps = options_.backend.static_max_gyro_std_radps;
+    rest.noise = options_.backend.imuNoise(rig_.rig.imu);
     gyro_bias_window.emplace(options_.init.gyro_bias_window_s, options_.init.gyro_bias_keyframe_s,
-                             tracker_camera_->camera, tracker_camera_->T_B_C.rotation(), offset_ns_);
+                             tracker_camera_->camera, tracker_camera_->T_B_C.rotation(), offset_ns_, rest);
+  }
   backend_stage_ = std::make_unique<BackendStage>(*backend_, std::move(initializer), std::move(gyro_bias_window));
   health_ = std::make_unique<HealthMonitor>(options_.health);
 }

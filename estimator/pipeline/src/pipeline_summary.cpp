@@ -29,6 +29,8 @@ void emitGyroBias(YAML::Emitter& out, const GyroBiasEstimate& e) {
   constexpr double kDeg = 180.0 / M_PI;
   out << YAML::Key << "gyro_bias_from_tracks" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "from_tracks" << YAML::Value << e.from_tracks;
+  out << YAML::Key << "at_rest" << YAML::Value << e.at_rest;
+  if (e.at_rest) emitSeconds(out, "rest_s", e.rest_s);
   emitVector(out, "b_g_degps", kDeg * e.b_g);
   emitVector(out, "sigma_degps", kDeg * e.covariance.diagonal().cwiseSqrt());
   if (e.from_tracks) {

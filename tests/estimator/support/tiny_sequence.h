@@ -47,6 +47,7 @@ struct TinySequenceOptions {
   std::vector<std::pair<double, double>> imu_gaps_s;  ///< [t0, t1) without IMU readings
   double imu_end_s = -1.0;              ///< imu.txt ends here (< 0: at the end)
   Vec3 gyro_bias_radps = Vec3::Zero();  ///< the simulated gyroscope's bias at the start
+  std::string trajectory_preset = "six_dof.yaml";  ///< from trajectories/presets (flight.yaml: 2 s at rest first)
   std::uint64_t seed = 1;
 };
 
@@ -82,15 +83,15 @@ inline SensorRig tinyRig(double imu_rate_hz) {
   return rig;
 }
 
-/// The body trajectory of the tiny sequences (six_dof preset, 60 s long).
-inline std::unique_ptr<ContinuousTrajectory> tinyTrajectory() {
-  return makeTrajectory(trajectoryPresetPath("six_dof.yaml"));
+/// The body trajectory of the tiny sequences (by default the six_dof preset, 60 s long).
+inline std::unique_ptr<ContinuousTrajectory> tinyTrajectory(const std::string& preset = "six_dof.yaml") {
+  return makeTrajectory(trajectoryPresetPath(preset));
 }
 
 inline void writeTinySequence(const std::string& folder, const TinySequenceOptions& o) {
   namespace fs = std::filesystem;
   fs::create_directories(fs::path(folder) / "truth");
-  const auto traj = tinyTrajectory();
+  const auto traj = tinyTrajectory(o.trajectory_preset);
   const TimeNs t0 = traj->startTime();
   const TimeNs t_end = t0 + secondsToNs(o.duration_s);
   const Camera camera = tinyCamera();

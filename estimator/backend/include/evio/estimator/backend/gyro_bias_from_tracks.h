@@ -104,6 +104,11 @@ struct GyroBiasEstimate {
   /// The split-half check's q (gyro_bias_from_tracks.cpp): about 1 when the
   /// covariance fits the data; 0 when not run.
   double split_half_q = 0.0;
+  /// The window's IMU was at rest (static_initializer.h restMeasurement): the
+  /// biases came from its mean readings instead of the tracks, and the
+  /// filter starts with their covariance as well.
+  bool at_rest = false;
+  double rest_s = 0.0;  ///< the readings' span, s
 };
 
 /// The bundle adjustment's result (refineGyroBiasByBundleAdjustment).

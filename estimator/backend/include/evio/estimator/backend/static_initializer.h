@@ -10,6 +10,7 @@
 
 #include "evio/core/imu_sample.h"
 #include "evio/estimator/backend/filter_state.h"
+#include "evio/estimator/backend/imu_propagation.h"
 
 namespace evio::estimator {
 
@@ -25,5 +26,44 @@ struct StaticInitResult {
 std::optional<StaticInitResult> staticInitialize(const ImuSamples& samples, double gravity_mps2,
                                                  double max_acc_std_mps2, double max_gyro_std_radps,
                                                  const Vec3& p_W_B = Vec3::Zero(), double yaw_rad = 0.0);
+
+/// What a still IMU says about the state (docs/algorithms.md#gyroscope-bias-from-tracks,
+/// "At rest"): over T seconds at rest the mean rate is the gyroscope bias and
+/// the mean specific force is gravity seen in the body plus the accelerometer
+/// bias,
+///   ω̄ = b_g + n_g,   ā = R_W_Bᵀ (0, 0, g) + b_a + n_a,
+/// with n the white noise of density σ averaged over T (variance σ²/T per
+/// axis) plus the bias's own random walk over the window (σ_b² T / 3, the
+/// variance of its mean about its value at the start). The planet's rotation
+/// (7e-5 rad/s on Earth and Mars) is not removed.
+struct RestMeasurement {
+  TimeNs t0_ns = 0, t1_ns = 0;  ///< the readings' span
+  Vec3 mean_gyro = Vec3::Zero(), mean_acc = Vec3::Zero();
+  double gyro_variance = 0.0;   ///< per axis, (rad/s)²
+  double acc_variance = 0.0;    ///< per axis, (m/s²)²
+  double durationS() const { return nsToSeconds(t1_ns - t0_ns); }
+};
+
+/// The rest measurement of `samples` when staticInitialize accepts them as
+/// still and they span a positive time; std::nullopt otherwise. The spread
+/// bounds are what motion may add: each is combined in quadrature with the
+/// white noise's spread per reading, σ √f at the readings' rate f.
+std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double gravity_mps2, double max_acc_std_mps2,
+                                               double max_gyro_std_radps, const ImuNoiseDensities& noise);
+
+/// The rest measurement as one Kalman update of the IMU state x (error state
+/// and covariance P in the filter's order, filter_state.h) at the window's
+/// start: H = [∂h/∂δθ = [R̂ᵀ g_up]×, ∂h/∂b_a = I] for the force (the local
+/// attitude error, R = R̂ Exp(δθ), so Rᵀ g_up ≈ R̂ᵀ g_up + [R̂ᵀ g_up]× δθ) and
+/// ∂h/∂b_g = I for the rate. The attitude and the accelerometer bias stay
+/// correlated through it: with a loose attitude the force moves the tilt and
+/// b_a together. The update is iterated (relinearised at each iterate) and
+/// the force's noise carries the covariance of its second-order terms in
+/// the prior's attitude error (a tilt lowers it along itself, a yaw error
+/// turns the tilt's term sideways), which a loose attitude makes larger
+/// than the readings' noise. Returns false (x, P untouched) if S is not
+/// positive definite.
+bool applyRestMeasurement(const RestMeasurement& rest, double gravity_mps2, ImuState* x,
+                          Eigen::Matrix<double, 15, 15>* P);
 
 }  // namespace evio::estimator

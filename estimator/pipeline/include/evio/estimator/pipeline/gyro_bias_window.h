@@ -10,6 +10,10 @@
 /// state's, and the buffered inputs are replayed through the filter from the
 /// initial state with that bias as its mean; the bias's covariance stays the
 /// prior's, because the replay gives the filter the window's tracks again.
+/// If the window's IMU readings are at rest (WindowRestTest), they give both
+/// biases instead (static_initializer.h restMeasurement), applied to the
+/// initial state with their covariance: the replay holds no rest
+/// measurement, so nothing is counted twice.
 /// Memory: one window of inputs.
 
 #include <optional>
@@ -17,15 +21,26 @@
 
 #include "evio/core/camera/camera.h"
 #include "evio/estimator/backend/gyro_bias_from_tracks.h"
+#include "evio/estimator/backend/static_initializer.h"
 #include "evio/estimator/measurements.h"
 #include "evio/estimator/pipeline/backend_input.h"
 
 namespace evio::estimator {
 
+/// When the window's IMU counts as at rest (the static initialiser's bounds).
+struct WindowRestTest {
+  bool enabled = false;
+  double gravity_mps2 = 9.81;
+  double max_acc_std_mps2 = 0.1;     ///< per-axis spread bound, m/s²
+  double max_gyro_std_radps = 0.02;  ///< rad/s
+  ImuNoiseDensities noise;           ///< the filter's IMU noise
+};
+
 class GyroBiasWindow {
  public:
   GyroBiasWindow(double window_s, double keyframe_s, const Camera& camera, const Mat3& R_B_C,
-                 TimeNs time_offset_cam_imu_ns, const GyroBiasFromTracksOptions& solver = {});
+                 TimeNs time_offset_cam_imu_ns, const WindowRestTest& rest_test = {},
+                 const GyroBiasFromTracksOptions& solver = {});
 
   /// Opens the window at the initial state x0 (IMU clock).
   void open(const ImuState& x0);
@@ -35,7 +50,12 @@ class GyroBiasWindow {
   bool add(BackendInput in);
   /// The estimate from what the window holds (prior: x0's bias and the bias
   /// block of P0); the window is then closed.
+  /// At rest, the estimate is the prior with at_rest set and rest() holds
+  /// the measurement; the caller applies it (BackendStage).
   GyroBiasEstimate estimate(const Mat3& prior_covariance);
+  /// The rest measurement of the last estimate(), if the IMU was at rest.
+  const std::optional<RestMeasurement>& rest() const { return rest_; }
+  double gravity() const { return rest_test_.gravity_mps2; }
   const ImuState& initialState() const { return *x0_; }
   /// The buffered inputs in their order, moved out.
   std::vector<BackendInput> takeInputs() { return std::move(inputs_); }
@@ -47,7 +67,9 @@ class GyroBiasWindow {
   Camera camera_;
   Mat3 R_B_C_;
   TimeNs offset_ns_;
+  WindowRestTest rest_test_;
   GyroBiasFromTracksOptions solver_;
+  std::optional<RestMeasurement> rest_;
   std::optional<ImuState> x0_;
   bool complete_ = false;
   TimeNs next_keyframe_ns_ = 0;

@@ -67,6 +67,10 @@ struct InitOptions {
   double gyro_bias_window_s = 0.0;
   /// Keyframe spacing inside that window, s.
   double gyro_bias_keyframe_s = 0.1;
+  /// Test the window's IMU for rest first (backend.static_max_*_std bounds):
+  /// at rest its mean readings give both biases (and the tilt) as one update
+  /// of the initial state, with their covariance, instead of the tracks.
+  bool gyro_bias_window_rest = true;
 
   template <class V>
   void fields(V& v) {
@@ -76,6 +80,7 @@ struct InitOptions {
     v("perturb", perturb, "groundtruth: add an error drawn from the backend's initial covariance");
     v("gyro_bias_window_s", gyro_bias_window_s, "groundtruth: gyroscope bias from this long of tracks first, s (0: off)");
     v("gyro_bias_keyframe_s", gyro_bias_keyframe_s, "keyframe spacing in the gyroscope-bias window, s");
+    v("gyro_bias_window_rest", gyro_bias_window_rest, "a window whose IMU is at rest gives both biases from its mean");
   }
   void validate() const;
 };

@@ -80,14 +80,21 @@ TEST(RestMeasurement, MeanReadingsAndTheirAnalyticVariance) {
   EXPECT_LT((m->mean_acc - mean_acc).norm(), 1e-12);
   EXPECT_LT((m->mean_gyro - mean_gyro).norm(), 1e-12);
   EXPECT_DOUBLE_EQ(m->durationS(), 1.0);
-  // σ²/T + σ_b² T / 3 with T = 1 s.
-  EXPECT_NEAR(m->gyro_variance, 2e-4 * 2e-4 + 2e-5 * 2e-5 / 3.0, 1e-18);
-  EXPECT_NEAR(m->acc_variance, 0.004316 * 0.004316 + 3e-3 * 3e-3 / 3.0, 1e-15);
+  // σ² f / N + σ_b² T / 3 with f = 1 kHz, N = 1001 readings, T = 1 s.
+  EXPECT_NEAR(m->gyro_variance, 2e-4 * 2e-4 * 1000.0 / 1001.0 + 2e-5 * 2e-5 / 3.0, 1e-18);
+  EXPECT_NEAR(m->acc_variance, 0.004316 * 0.004316 * 1000.0 / 1001.0 + 3e-3 * 3e-3 / 3.0, 1e-15);
+  // A gap over the second half: the rate by the median spacing stays 1 kHz,
+  // N = 502 readings, so the mean's variance is about twice σ²/T.
+  ImuSamples gapped(samples.begin(), samples.begin() + 501);
+  gapped.push_back(samples.back());
+  const std::optional<RestMeasurement> g = restMeasurement(gapped, kMarsGravity, 0.1, 0.02, restNoise());
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(g->gyro_variance, 2e-4 * 2e-4 * 1000.0 / 502.0, 1e-18);
   // The mean rate is the bias to within 4σ of its white noise (σ_g/√T).
   EXPECT_LT((m->mean_gyro - body.b_g).cwiseAbs().maxCoeff(), 4.0 * 2e-4);
 }
 
-TEST(RestMeasurement, ATurningOrShakenImuIsNotAtRest) {
+TEST(RestMeasurement, ATurningOrFallingImuIsNotAtRest) {
   std::mt19937_64 rng(8);
   Body turning;
   turning.rate_amplitude = Vec3(0.0, 0.0, 0.05);  // ±2.9 °/s at 1 Hz: spread 0.035 rad/s
@@ -95,6 +102,8 @@ TEST(RestMeasurement, ATurningOrShakenImuIsNotAtRest) {
   Body still;
   EXPECT_TRUE(restMeasurement(restReadings(still, 1.0, rng), kMarsGravity, 0.1, 0.02, restNoise()).has_value());
   // Readings whose mean force is not gravity (a free fall, a wrong rig) are not rest.
+  // (The steady turn and the smooth acceleration the spread cannot see are
+  // the χ² gate's: TheGateRejectsASteadyTurnAndASteadyAcceleration.)
   ImuSamples falling = restReadings(still, 1.0, rng);
   for (ImuSample& s : falling) s.acc_B *= 0.5;
   EXPECT_FALSE(restMeasurement(falling, kMarsGravity, 0.1, 0.02, restNoise()).has_value());
@@ -147,10 +156,10 @@ TEST(RestMeasurement, TheUpdateIsConsistentWithTheAttitudeKnownAndLoose) {
   // to its noise (σ_a/√T = 0.0043 m/s²). With a loose attitude (3°) the
   // horizontal force cannot tell tilt from bias, and the force's
   // second-order terms in the attitude error reach 0.03 m/s²; the update
-  // carries them as noise with a Gaussian's covariance, which their χ²-like
-  // tails exceed: measured 9.78, allowed within 10 % of 9. Without the
-  // iteration the mean was 157, with it but without the second-order noise
-  // 13.5; a wrong sign of ∂h/∂δθ diverges.
+  // carries their mean in the prediction and their covariance as noise, the
+  // same bounds apply. Without the iteration the mean was 157, without the
+  // second-order noise 13.5, without its mean 9.78; a wrong sign of ∂h/∂δθ
+  // diverges.
   double max_ba = 0.0;
   const double known = meanNeesAfterUpdate(0.001 * M_PI / 180.0, 1000, &max_ba);
   std::printf("rest update, attitude known: mean NEES %.2f (9 DOF), max |b_a error| %.4f m/s^2\n", known, max_ba);
@@ -160,8 +169,38 @@ TEST(RestMeasurement, TheUpdateIsConsistentWithTheAttitudeKnownAndLoose) {
   const double loose = meanNeesAfterUpdate(3.0 * M_PI / 180.0, 1000, &max_ba);
   std::printf("rest update, attitude loose (3 deg): mean NEES %.2f (9 DOF), max |b_a error| %.4f m/s^2\n", loose,
               max_ba);
-  EXPECT_GT(loose, 0.9 * 9.0);
-  EXPECT_LT(loose, 1.1 * 9.0);
+  EXPECT_GT(loose, 8.74);
+  EXPECT_LT(loose, 9.26);
+}
+
+TEST(RestMeasurement, TheGateRejectsASteadyTurnAndASteadyAcceleration) {
+  // Both pass the spread test (no spread beyond the noise) and would be
+  // taken for bias: a steady 30 °/s turn (5σ of the prior's 6 °/s) and a
+  // steady 2 m/s² sideways (6.7σ of 0.3 m/s²) fail the χ²₆ gate at 0.999;
+  // a bias of 2σ passes it.
+  std::mt19937_64 rng(12);
+  const auto update = [&](const Body& body) {
+    const std::optional<RestMeasurement> m =
+        restMeasurement(restReadings(body, 1.0, rng, kEarthGravity), kEarthGravity, 0.1, 0.02, restNoise());
+    if (!m) return false;
+    ImuState x;
+    x.q_W_B = body.q_W_B;
+    Eigen::Matrix<double, 15, 15> P = Eigen::Matrix<double, 15, 15>::Identity() * 1e-6;
+    P.block<3, 3>(kIdxTheta, kIdxTheta).diagonal().setConstant(std::pow(0.001 * M_PI / 180.0, 2));
+    P.block<3, 3>(kIdxBg, kIdxBg).diagonal().setConstant(std::pow(6.0 * M_PI / 180.0, 2));
+    P.block<3, 3>(kIdxBa, kIdxBa).diagonal().setConstant(0.09);
+    return applyRestMeasurement(*m, kEarthGravity, &x, &P);
+  };
+  Body turning;
+  turning.b_g = Vec3(0.0, 0.0, 30.0 * M_PI / 180.0);
+  EXPECT_FALSE(update(turning));
+  Body accelerating;
+  accelerating.b_a = Vec3(2.0, 0.0, 0.0);
+  EXPECT_FALSE(update(accelerating));
+  Body biased;
+  biased.b_g = Vec3(0.0, 12.0 * M_PI / 180.0, 0.0);
+  biased.b_a = Vec3(0.0, 0.0, 0.6);
+  EXPECT_TRUE(update(biased));
 }
 
 }  // namespace

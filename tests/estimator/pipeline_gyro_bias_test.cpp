@@ -67,7 +67,8 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   // The flight preset's first 2 s on the ground: the window's IMU is at rest,
   // so its mean rate gives the simulated 4.1 °/s bias to its white noise,
   // σ_g/√T (the tiny rig's σ_g = 2e-4 rad/s/√Hz, T = 1 s: 0.011 °/s), and the
-  // filter starts with that covariance, not the prior's 6 °/s. With the rest
+  // filter starts with that covariance, not the prior's 6 °/s, at the
+  // window's end. With the rest
   // test off the same window goes to the tracks (a camera at rest shows a
   // rotation error too: the tracks find the bias, and the filter keeps the
   // prior's σ, since it takes the tracks again).
@@ -84,6 +85,9 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   EXPECT_TRUE(r.gyro_bias->at_rest);
   EXPECT_FALSE(r.gyro_bias->from_tracks);
   EXPECT_NEAR(r.gyro_bias->rest_s, 1.0, 0.01);
+  // The window at rest is the initialisation: the filter starts at its end.
+  ASSERT_TRUE(r.initialization_t_ns.has_value());
+  EXPECT_NEAR(nsToSeconds(*r.initialization_t_ns), 1.0, 0.01);
   const Vec3 d = r.gyro_bias->b_g - kTrueBias;
   const double sigma = std::sqrt(r.gyro_bias->covariance(0, 0));
   EXPECT_LT(sigma, 0.02 * M_PI / 180.0);

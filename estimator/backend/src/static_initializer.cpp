@@ -1,6 +1,8 @@
 #include "evio/estimator/backend/static_initializer.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Cholesky>
 
@@ -60,7 +62,16 @@ std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double
   // per reading, σ √f at f readings per second, is added in quadrature, so
   // that a still IMU passes at any rate (1 kHz: 0.14 m/s², 0.006 rad/s at
   // the DAVIS240's densities).
-  const double f = static_cast<double>(samples.size() - 1) / T;
+  // f: the sensor's rate from the median spacing, so that a gap in the
+  // readings does not pass for a slower sensor (the variance of a mean of N
+  // readings is σ² f / N, not σ²/T, when some are missing).
+  std::vector<TimeNs> spacing;
+  spacing.reserve(samples.size() - 1);
+  for (std::size_t i = 1; i < samples.size(); ++i) spacing.push_back(samples[i].t_ns - samples[i - 1].t_ns);
+  std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
+  const double median_dt = nsToSeconds(spacing[spacing.size() / 2]);
+  if (!(median_dt > 0.0)) return std::nullopt;
+  const double f = 1.0 / median_dt;
   const auto bound = [f](double motion, double density) { return std::sqrt(motion * motion + density * density * f); };
   const std::optional<StaticInitResult> still =
       staticInitialize(samples, gravity_mps2, bound(max_acc_std_mps2, noise.accelerometer_noise_density),
@@ -69,8 +80,9 @@ std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double
   for (const ImuSample& s : samples) m.mean_acc += s.acc_B;
   m.mean_acc /= static_cast<double>(samples.size());
   m.mean_gyro = still->state.b_g;
-  const auto variance = [T](double density, double random_walk) {
-    return density * density / T + random_walk * random_walk * T / 3.0;
+  const double n = static_cast<double>(samples.size());
+  const auto variance = [T, f, n](double density, double random_walk) {
+    return density * density * f / n + random_walk * random_walk * T / 3.0;
   };
   m.gyro_variance = variance(noise.gyroscope_noise_density, noise.gyroscope_random_walk);
   m.acc_variance = variance(noise.accelerometer_noise_density, noise.accelerometer_random_walk);
@@ -96,19 +108,27 @@ ImuState boxPlus(const ImuState& x0, const Eigen::Matrix<double, 15, 1>& dx) {
 /// term sideways, by g ψ θ. No linearisation carries either; with the
 /// prior's σ of 3° they reach 0.03 m/s², seven times a second's mean noise.
 /// q_k = ½ eᵀ B_k e with B_k = ½ (u_k fᵀ + f u_kᵀ) − f_k I (u_k the k-th
-/// axis), and for e ~ N(0, P_θ) (Isserlis) Cov(q_k, q_l) = ½ tr(B_k P_θ B_l P_θ).
-Mat3 secondOrderForceCovariance(const ImuState& x, const Mat3& P_theta, double gravity_mps2) {
+/// axis), and for e ~ N(0, P_θ): E[q_k] = ½ tr(B_k P_θ) (along the force
+/// −g σ⊥², σ⊥² the tilt variance summed over both axes) and, by Isserlis,
+/// Cov(q_k, q_l) = ½ tr(B_k P_θ B_l P_θ).
+struct SecondOrderForce {
+  Vec3 mean = Vec3::Zero();  ///< E[q] = ½ tr(B_k P_θ) per axis
+  Mat3 covariance = Mat3::Zero();
+};
+
+SecondOrderForce secondOrderForce(const ImuState& x, const Mat3& P_theta, double gravity_mps2) {
   const Vec3 f = x.q_W_B.toRotationMatrix().transpose() * Vec3(0.0, 0.0, gravity_mps2);
   Mat3 BP[3];
+  SecondOrderForce out;
   for (int k = 0; k < 3; ++k) {
     const Vec3 u = Vec3::Unit(k);
     const Mat3 B = 0.5 * (u * f.transpose() + f * u.transpose()) - f(k) * Mat3::Identity();
     BP[k] = B * P_theta;
+    out.mean(k) = 0.5 * BP[k].trace();
   }
-  Mat3 cov;
   for (int k = 0; k < 3; ++k)
-    for (int l = 0; l < 3; ++l) cov(k, l) = 0.5 * (BP[k] * BP[l]).trace();
-  return cov;
+    for (int l = 0; l < 3; ++l) out.covariance(k, l) = 0.5 * (BP[k] * BP[l]).trace();
+  return out;
 }
 
 /// x ⊟ x0: the error state taking x0 to x.
@@ -128,6 +148,9 @@ namespace {
 
 using Matrix15 = Eigen::Matrix<double, 15, 15>;
 
+/// χ²₆ at 0.999: the rest measurement's innovation against the prior.
+constexpr double kRestGateChi2 = 22.458;
+
 /// The iterated update of (x, P) by the rest measurement with noise R.
 /// Iterated because the force is quadratic in the attitude error (its
 /// vertical part falls by g θ²/2, 0.013 m/s² at 3°, three times the noise of
@@ -135,8 +158,10 @@ using Matrix15 = Eigen::Matrix<double, 15, 15>;
 /// each iterate until the step is below 1e-12; then the Joseph form at the
 /// last linearisation (the prior is wide, the rest tight: it keeps P
 /// symmetric and positive semi-definite).
-bool iteratedRestUpdate(const RestMeasurement& rest, double gravity_mps2, const Eigen::Matrix<double, 6, 6>& R,
-                        ImuState* x, Matrix15* P) {
+bool iteratedRestUpdate(const RestMeasurement& rest, double gravity_mps2, const SecondOrderForce& q,
+                        const Eigen::Matrix<double, 6, 6>& R0, ImuState* x, Matrix15* P) {
+  Eigen::Matrix<double, 6, 6> R = R0;
+  R.block<3, 3>(3, 3) += q.covariance;
   const ImuState x0 = *x;
   ImuState xi = x0;
   Eigen::Matrix<double, 6, 15> H;
@@ -149,11 +174,15 @@ bool iteratedRestUpdate(const RestMeasurement& rest, double gravity_mps2, const 
     H.block<3, 3>(3, kIdxBa).setIdentity();
     Eigen::Matrix<double, 6, 1> r;
     r.head<3>() = rest.mean_gyro - xi.b_g;
-    r.tail<3>() = rest.mean_acc - (f_B + xi.b_a);
+    r.tail<3>() = rest.mean_acc - (f_B + xi.b_a + q.mean);
     const Eigen::Matrix<double, 15, 1> di = boxMinus(xi, x0);
     const Eigen::Matrix<double, 15, 6> PHt = *P * H.transpose();
     const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(H * PHt + R);
     if (llt.info() != Eigen::Success) return false;
+    // The rest hypothesis is tested against the prior at the first
+    // linearisation: a body turning at a steady rate or accelerating
+    // smoothly passes the spread test, and its mean would be taken as bias.
+    if (it == 0 && r.dot(llt.solve(r)) > kRestGateChi2) return false;
     K = llt.solve(PHt.transpose()).transpose();
     const Eigen::Matrix<double, 15, 1> dx = K * (r + H * di);
     const double step = (dx - di).norm();
@@ -178,14 +207,12 @@ bool applyRestMeasurement(const RestMeasurement& rest, double gravity_mps2, ImuS
   // from the prior with the attitude covariance that one left.
   ImuState x1 = *x;
   Matrix15 P1 = *P;
-  Eigen::Matrix<double, 6, 6> R1 = R;
-  R1.block<3, 3>(3, 3) += secondOrderForceCovariance(*x, P->block<3, 3>(kIdxTheta, kIdxTheta), gravity_mps2);
-  if (!iteratedRestUpdate(rest, gravity_mps2, R1, &x1, &P1)) return false;
-  Eigen::Matrix<double, 6, 6> R2 = R;
-  R2.block<3, 3>(3, 3) += secondOrderForceCovariance(x1, P1.block<3, 3>(kIdxTheta, kIdxTheta), gravity_mps2);
+  const SecondOrderForce q1 = secondOrderForce(*x, P->block<3, 3>(kIdxTheta, kIdxTheta), gravity_mps2);
+  if (!iteratedRestUpdate(rest, gravity_mps2, q1, R, &x1, &P1)) return false;
+  const SecondOrderForce q2 = secondOrderForce(x1, P1.block<3, 3>(kIdxTheta, kIdxTheta), gravity_mps2);
   ImuState x2 = *x;
   Matrix15 P2 = *P;
-  if (!iteratedRestUpdate(rest, gravity_mps2, R2, &x2, &P2)) return false;
+  if (!iteratedRestUpdate(rest, gravity_mps2, q2, R, &x2, &P2)) return false;
   *x = x2;
   *P = P2;
   return true;

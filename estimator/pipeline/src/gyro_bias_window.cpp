@@ -58,30 +58,50 @@ void GyroBiasWindow::addKeyframe(const MeasurementSet& set, TimeNs t_imu_ns) {
   keyframes_.push_back(std::move(kf));
 }
 
-GyroBiasEstimate GyroBiasWindow::estimate(const Mat3& prior_covariance) {
+GyroBiasEstimate GyroBiasWindow::estimate(const Eigen::Matrix<double, 15, 15>& P0) {
   complete_ = true;
-  // Only keyframes the readings cover can be integrated between (x0 may lie
-  // up to one IMU period before the first reading the window holds).
-  const TimeNs t_first = imu_.empty() ? x0_->t_ns : imu_.front().t_ns;
-  const TimeNs t_last = imu_.empty() ? x0_->t_ns : imu_.back().t_ns;
-  keyframes_.erase(std::remove_if(keyframes_.begin(), keyframes_.end(),
-                                  [&](const BearingKeyframe& k) { return k.t_imu_ns < t_first || k.t_imu_ns > t_last; }),
-                   keyframes_.end());
-  if (rest_test_.enabled)
-    rest_ = restMeasurement(imu_, rest_test_.gravity_mps2, rest_test_.max_acc_std_mps2,
-                            rest_test_.max_gyro_std_radps, rest_test_.noise);
+  const Mat3 prior_covariance = P0.block<3, 3>(kIdxBg, kIdxBg);
   GyroBiasEstimate e;
-  if (rest_) {
-    e.b_g = x0_->b_g;
-    e.covariance = prior_covariance;
-    e.at_rest = true;
-    e.rest_s = rest_->durationS();
-  } else {
+  if (rest_test_.enabled) {
+    const std::optional<RestMeasurement> rest = restMeasurement(
+        imu_, rest_test_.gravity_mps2, rest_test_.max_acc_std_mps2, rest_test_.max_gyro_std_radps, rest_test_.noise);
+    ImuState x = *x0_;
+    Eigen::Matrix<double, 15, 15> P = P0;
+    if (rest && applyRestMeasurement(*rest, rest_test_.gravity_mps2, &x, &P)) {
+      x.t_ns = rest->t1_ns;  // at rest nothing moved: the same state at the window's end
+      e.b_g = x.b_g;
+      e.covariance = P.block<3, 3>(kIdxBg, kIdxBg);
+      e.at_rest = true;
+      e.rest_s = rest->durationS();
+      rest_start_.emplace(x, P);
+    }
+  }
+  if (!e.at_rest) {
+    // Only keyframes the readings cover can be integrated between (x0 may lie
+    // up to one IMU period before the first reading the window holds).
+    const TimeNs t_first = imu_.empty() ? x0_->t_ns : imu_.front().t_ns;
+    const TimeNs t_last = imu_.empty() ? x0_->t_ns : imu_.back().t_ns;
+    keyframes_.erase(std::remove_if(keyframes_.begin(), keyframes_.end(),
+                                    [&](const BearingKeyframe& k) { return k.t_imu_ns < t_first || k.t_imu_ns > t_last; }),
+                     keyframes_.end());
     e = estimateGyroBiasFromTracks(keyframes_, imu_, R_B_C_, x0_->b_g, prior_covariance, solver_);
   }
   imu_ = ImuSamples();
   keyframes_ = std::vector<BearingKeyframe>();
   return e;
+}
+
+std::vector<BackendInput> GyroBiasWindow::takeInputsFrom(TimeNs t_imu_ns) {
+  std::vector<BackendInput> out;
+  for (BackendInput& in : inputs_) {
+    TimeNs t_imu = 0;
+    if (const auto* imu = std::get_if<ImuSample>(&in)) t_imu = imu->t_ns;
+    else if (const auto* set = std::get_if<MeasurementSet>(&in)) t_imu = set->t_ns + offset_ns_;
+    else t_imu = std::get<RangeMeasurement>(in).t_ns + offset_ns_;
+    if (t_imu >= t_imu_ns) out.push_back(std::move(in));
+  }
+  inputs_.clear();
+  return out;
 }
 
 }  // namespace evio::estimator

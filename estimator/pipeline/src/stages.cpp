@@ -128,24 +128,23 @@ void BackendStage::finish(std::vector<Estimate>& out) {
 }
 
 void BackendStage::closeWindow(std::vector<Estimate>& out) {
-  Eigen::Matrix<double, 15, 15> P0 = backend_.initialCovariance();
-  gyro_bias_ = window_->estimate(P0.block<3, 3>(kIdxBg, kIdxBg));
-  ImuState x0 = window_->initialState();
-  if (const std::optional<RestMeasurement>& rest = window_->rest()) {
-    // At rest: the mean readings update the initial state, mean and
-    // covariance; the replay holds no rest measurement, so nothing is
-    // counted twice. If the update fails, the prior stands.
-    if (applyRestMeasurement(*rest, window_->gravity(), &x0, &P0)) {
-      gyro_bias_->b_g = x0.b_g;
-      gyro_bias_->covariance = P0.block<3, 3>(kIdxBg, kIdxBg);
-    }
-  } else {
-    // The tracks' estimate moves the bias's mean, the point the filter
-    // linearises at; its covariance stays the prior's, since the filter is
-    // about to take the window's tracks again (told both, it would count
-    // them twice).
-    x0.b_g = gyro_bias_->b_g;
+  const Eigen::Matrix<double, 15, 15> P0 = backend_.initialCovariance();
+  gyro_bias_ = window_->estimate(P0);
+  if (const auto& rest = window_->restStart()) {
+    // At rest the window is the initialisation: the filter starts at its end
+    // with the rest update's state and covariance, and takes the inputs from
+    // then on (propagating through the readings the update averaged, it
+    // would take their noise twice).
+    backend_.initialize(rest->first, rest->second);
+    for (BackendInput& in : window_->takeInputsFrom(rest->first.t_ns)) feed(in, out);
+    return;
   }
+  // The tracks' estimate moves the bias's mean, the point the filter
+  // linearises at; its covariance stays the prior's, since the filter is
+  // about to take the window's tracks again (told both, it would count them
+  // twice).
+  ImuState x0 = window_->initialState();
+  x0.b_g = gyro_bias_->b_g;
   backend_.initialize(x0, P0);
   for (BackendInput& in : window_->takeInputs()) feed(in, out);
 }

@@ -32,9 +32,10 @@ std::optional<StaticInitResult> staticInitialize(const ImuSamples& samples, doub
 /// the mean specific force is gravity seen in the body plus the accelerometer
 /// bias,
 ///   ω̄ = b_g + n_g,   ā = R_W_Bᵀ (0, 0, g) + b_a + n_a,
-/// with n the white noise of density σ averaged over T (variance σ²/T per
-/// axis) plus the bias's own random walk over the window (σ_b² T / 3, the
-/// variance of its mean about its value at the start). The planet's rotation
+/// with n the white noise of density σ averaged over the N readings (variance
+/// σ² f / N per axis at the sensor's rate f, the median spacing's inverse:
+/// σ²/T without gaps) plus the bias's own random walk over the window
+/// (σ_b² T / 3, the variance of its mean about its value at the start). The planet's rotation
 /// (7e-5 rad/s on Earth and Mars) is not removed.
 struct RestMeasurement {
   TimeNs t0_ns = 0, t1_ns = 0;  ///< the readings' span
@@ -58,11 +59,13 @@ std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double
 /// ∂h/∂b_g = I for the rate. The attitude and the accelerometer bias stay
 /// correlated through it: with a loose attitude the force moves the tilt and
 /// b_a together. The update is iterated (relinearised at each iterate) and
-/// the force's noise carries the covariance of its second-order terms in
-/// the prior's attitude error (a tilt lowers it along itself, a yaw error
-/// turns the tilt's term sideways), which a loose attitude makes larger
-/// than the readings' noise. Returns false (x, P untouched) if S is not
-/// positive definite.
+/// the force's prediction and noise carry the mean and covariance of its
+/// second-order terms in the attitude error (a tilt lowers it along itself,
+/// a yaw error turns the tilt's term sideways), which a loose attitude
+/// makes larger than the readings' noise. Returns false (x, P untouched) if
+/// S is not positive definite or the innovation fails the χ²₆ gate at 0.999
+/// against the prior (a steady turn or a smooth acceleration, which the
+/// spread test cannot see, taken for bias).
 bool applyRestMeasurement(const RestMeasurement& rest, double gravity_mps2, ImuState* x,
                           Eigen::Matrix<double, 15, 15>* P);
 

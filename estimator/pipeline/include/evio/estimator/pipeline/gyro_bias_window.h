@@ -10,13 +10,17 @@
 /// state's, and the buffered inputs are replayed through the filter from the
 /// initial state with that bias as its mean; the bias's covariance stays the
 /// prior's, because the replay gives the filter the window's tracks again.
-/// If the window's IMU readings are at rest (WindowRestTest), they give both
-/// biases instead (static_initializer.h restMeasurement), applied to the
-/// initial state with their covariance: the replay holds no rest
-/// measurement, so nothing is counted twice.
+/// If the window's IMU readings are at rest (WindowRestTest) and their mean
+/// passes the χ² gate against the prior, they give both biases instead
+/// (static_initializer.h restMeasurement, applyRestMeasurement), with their
+/// covariance, and the window is the initialisation itself: the filter
+/// starts at its end (at rest nothing moved) and only the inputs from then
+/// on are fed, so the readings the rest measurement averaged are not
+/// propagated through again.
 /// Memory: one window of inputs.
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "evio/core/camera/camera.h"
@@ -50,12 +54,15 @@ class GyroBiasWindow {
   bool add(BackendInput in);
   /// The estimate from what the window holds (prior: x0's bias and the bias
   /// block of P0); the window is then closed.
-  /// At rest, the estimate is the prior with at_rest set and rest() holds
-  /// the measurement; the caller applies it (BackendStage).
-  GyroBiasEstimate estimate(const Mat3& prior_covariance);
-  /// The rest measurement of the last estimate(), if the IMU was at rest.
-  const std::optional<RestMeasurement>& rest() const { return rest_; }
-  double gravity() const { return rest_test_.gravity_mps2; }
+  /// The estimate from what the window holds, given the initial state's
+  /// covariance P0 (its bias block is the tracks' prior). At rest (at_rest
+  /// set) restStart() holds the updated state at the window's end and its
+  /// covariance; the window is then closed.
+  GyroBiasEstimate estimate(const Eigen::Matrix<double, 15, 15>& P0);
+  /// At rest: the filter's start, the window's end, and its covariance.
+  const std::optional<std::pair<ImuState, Eigen::Matrix<double, 15, 15>>>& restStart() const { return rest_start_; }
+  /// The buffered inputs at or after t_imu_ns (IMU clock), in their order, moved out.
+  std::vector<BackendInput> takeInputsFrom(TimeNs t_imu_ns);
   const ImuState& initialState() const { return *x0_; }
   /// The buffered inputs in their order, moved out.
   std::vector<BackendInput> takeInputs() { return std::move(inputs_); }
@@ -69,7 +76,7 @@ class GyroBiasWindow {
   TimeNs offset_ns_;
   WindowRestTest rest_test_;
   GyroBiasFromTracksOptions solver_;
-  std::optional<RestMeasurement> rest_;
+  std::optional<std::pair<ImuState, Eigen::Matrix<double, 15, 15>>> rest_start_;
   std::optional<ImuState> x0_;
   bool complete_ = false;
   TimeNs next_keyframe_ns_ = 0;

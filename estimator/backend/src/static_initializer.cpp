@@ -91,17 +91,6 @@ std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double
 
 namespace {
 
-/// x0 ⊞ dx in the filter's convention (filter_state.cpp FilterState::correct).
-ImuState boxPlus(const ImuState& x0, const Eigen::Matrix<double, 15, 1>& dx) {
-  ImuState x = x0;
-  x.p_W_B += dx.segment<3>(kIdxP);
-  x.v_W += dx.segment<3>(kIdxV);
-  x.q_W_B = (x0.q_W_B * so3::expQuat(dx.segment<3>(kIdxTheta))).normalized();
-  x.b_g += dx.segment<3>(kIdxBg);
-  x.b_a += dx.segment<3>(kIdxBa);
-  return x;
-}
-
 /// The covariance of the force's second-order term in the attitude error e,
 /// Exp(−e) f ≈ f − e × f + q(e) with q(e) = ½ e × (e × f): a tilt lowers
 /// the force along itself by g |e⊥|²/2, and a yaw error turns the tilt's
@@ -131,15 +120,13 @@ SecondOrderForce secondOrderForce(const ImuState& x, const Mat3& P_theta, double
   return out;
 }
 
-/// x ⊟ x0: the error state taking x0 to x.
-Eigen::Matrix<double, 15, 1> boxMinus(const ImuState& x, const ImuState& x0) {
-  Eigen::Matrix<double, 15, 1> d;
-  d.segment<3>(kIdxP) = x.p_W_B - x0.p_W_B;
-  d.segment<3>(kIdxV) = x.v_W - x0.v_W;
-  d.segment<3>(kIdxTheta) = so3::log(x0.q_W_B.toRotationMatrix().transpose() * x.q_W_B.toRotationMatrix());
-  d.segment<3>(kIdxBg) = x.b_g - x0.b_g;
-  d.segment<3>(kIdxBa) = x.b_a - x0.b_a;
-  return d;
+/// A filter state of the IMU alone: its correct() and minus() are the
+/// filter's ⊞ and ⊟ (filter_state.cpp), so the update here retracts and
+/// compares states exactly as the filter does.
+FilterState imuOnly(const ImuState& x) {
+  FilterState s;
+  s.imu = x;
+  return s;
 }
 
 }  // namespace
@@ -162,20 +149,20 @@ bool iteratedRestUpdate(const RestMeasurement& rest, double gravity_mps2, const 
                         const Eigen::Matrix<double, 6, 6>& R0, ImuState* x, Matrix15* P) {
   Eigen::Matrix<double, 6, 6> R = R0;
   R.block<3, 3>(3, 3) += q.covariance;
-  const ImuState x0 = *x;
-  ImuState xi = x0;
+  const FilterState x0 = imuOnly(*x);
+  FilterState xi = x0;
   Eigen::Matrix<double, 6, 15> H;
   Eigen::Matrix<double, 15, 6> K;
   for (int it = 0; it < 10; ++it) {
-    const Vec3 f_B = xi.q_W_B.toRotationMatrix().transpose() * Vec3(0.0, 0.0, gravity_mps2);  // force at rest
+    const Vec3 f_B = xi.imu.q_W_B.toRotationMatrix().transpose() * Vec3(0.0, 0.0, gravity_mps2);  // force at rest
     H.setZero();
     H.block<3, 3>(0, kIdxBg).setIdentity();
     H.block<3, 3>(3, kIdxTheta) = so3::hat(f_B);
     H.block<3, 3>(3, kIdxBa).setIdentity();
     Eigen::Matrix<double, 6, 1> r;
-    r.head<3>() = rest.mean_gyro - xi.b_g;
-    r.tail<3>() = rest.mean_acc - (f_B + xi.b_a + q.mean);
-    const Eigen::Matrix<double, 15, 1> di = boxMinus(xi, x0);
+    r.head<3>() = rest.mean_gyro - xi.imu.b_g;
+    r.tail<3>() = rest.mean_acc - (f_B + xi.imu.b_a + q.mean);
+    const Eigen::Matrix<double, 15, 1> di = xi.minus(x0);
     const Eigen::Matrix<double, 15, 6> PHt = *P * H.transpose();
     const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(H * PHt + R);
     if (llt.info() != Eigen::Success) return false;
@@ -186,13 +173,14 @@ bool iteratedRestUpdate(const RestMeasurement& rest, double gravity_mps2, const 
     K = llt.solve(PHt.transpose()).transpose();
     const Eigen::Matrix<double, 15, 1> dx = K * (r + H * di);
     const double step = (dx - di).norm();
-    xi = boxPlus(x0, dx);
+    xi = x0;
+    xi.correct(dx);
     if (step < 1e-12) break;
   }
   const Matrix15 IKH = Matrix15::Identity() - K * H;
   const Matrix15 Pn = IKH * *P * IKH.transpose() + K * R * K.transpose();
   *P = 0.5 * (Pn + Pn.transpose());
-  *x = xi;
+  *x = xi.imu;
   return true;
 }
 

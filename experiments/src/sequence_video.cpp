@@ -1,7 +1,6 @@
 #include "evio/experiments/sequence_video.h"
 
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +14,7 @@
 #include "evio/core/io/events_h5.h"
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/images_txt.h"
+#include "evio/core/io/media_module.h"
 #include "evio/core/io/staged_folder.h"
 #include "evio/core/io/tracks_txt.h"
 #include "evio/core/options.h"
@@ -127,15 +127,16 @@ std::string chooseTracksFile(const std::string& folder, const std::string& optio
   return fs::is_regular_file(truth) ? truth.string() : std::string();
 }
 
-/// Opens a writer on `path`: H.264 if this OpenCV/FFmpeg has it, else MPEG-4 part 2.
-cv::VideoWriter openWriter(const std::string& path, const std::string& shown, double fps, cv::Size size,
-                           std::string& codec) {
-  cv::VideoWriter writer;
+/// Opens an encoder on `path` (through the media module): H.264 if this
+/// OpenCV/FFmpeg has it, else MPEG-4 part 2.
+std::unique_ptr<io::media::VideoEncoder> openEncoder(const std::string& path, const std::string& shown, double fps,
+                                                     cv::Size size, std::string& codec) {
+  const io::media::Api& media = io::media::api(shown);
   for (const char* fourcc : {"avc1", "mp4v"}) {
-    if (writer.open(path, cv::CAP_FFMPEG, cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]), fps,
-                    size, true)) {
+    std::unique_ptr<io::media::VideoEncoder> encoder(media.open_video(path, fourcc, fps, size.width, size.height));
+    if (encoder) {
       codec = fourcc;
-      return writer;
+      return encoder;
     }
   }
   throw Error(shown + ": no video encoder could open it (OpenCV's FFmpeg backend with H.264 or MPEG-4)");
@@ -177,8 +178,8 @@ VideoSummary writeSequenceVideo(const std::string& folder, const std::string& ou
 
   io::StagedFiles staged(output);
   const std::string staged_path = staged.path(output);
-  cv::VideoWriter writer = openWriter(staged_path, output, options.fps, cv::Size(summary.width, summary.height),
-                                      summary.codec);
+  const std::unique_ptr<io::media::VideoEncoder> writer =
+      openEncoder(staged_path, output, options.fps, cv::Size(summary.width, summary.height), summary.codec);
   const TimeNs window_ns = secondsToNs(options.window_s);
   const TimeNs tail_ns = secondsToNs(options.track_tail_s);
   std::deque<Event> window;
@@ -216,11 +217,11 @@ VideoSummary writeSequenceVideo(const std::string& folder, const std::string& ou
                   static_cast<double>(window.size()) / options.window_s / 1e3);
     cv::putText(video, text, cv::Point(6, 16 + 2 * s), cv::FONT_HERSHEY_SIMPLEX, 0.4 * s, cv::Scalar(0, 200, 255), 1,
                 cv::LINE_AA);
-    writer.write(video);
+    writer->write(video);
     ++summary.frames;
     if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(n_frames));
   }
-  writer.release();
+  writer->release();
   io::faultPoint(output);
   staged.publish();
   return summary;

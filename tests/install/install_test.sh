@@ -29,6 +29,9 @@ exercise() {
   "$evio" simulate experiments/scenarios/poster_6dof.yaml --set duration_s=1 output.write_events_txt=false -o seq -q \
     || fail "simulate from $evio"
   "$evio" info seq >/dev/null || fail "info"
+  # A video: FFmpeg through the media module installed beside the binary.
+  env -u EVIO_MEDIA_MODULE "$evio" video seq -o seq.mp4 --fps 10 -q || fail "video from $evio (the media module)"
+  [[ -s seq.mp4 ]] || fail "video wrote no file"
   # An estimator configuration named by its data-folder path.
   "$evio" estimate seq --method klt-vio --config estimator/config/sim.yaml --init groundtruth -o est -q \
     || fail "estimate with estimator/config/sim.yaml"

@@ -1,12 +1,13 @@
 #include "evio/core/io/image_file.h"
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <vector>
 
 #include "evio/core/error.h"
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/exr_file.h"
+#include "evio/core/io/media_module.h"
+#include "evio/core/io/png_codec.h"
 
 namespace evio::io {
 
@@ -36,18 +37,7 @@ cv::Mat readGrayImage(const std::string& path, PixelScale scale) {
     }
     return readExrChannel(path);
   }
-  std::vector<unsigned char> bytes;
-  {
-    const std::string data = readFile(path);  // names the file when missing
-    bytes.assign(data.begin(), data.end());
-  }
-  cv::Mat image;
-  try {
-    image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw Error::inFile(path, 0, std::string("cannot decode image: ") + e.what());
-  }
-  if (image.empty()) throw Error::inFile(path, 0, "cannot decode image (unknown or corrupt format)");
+  const cv::Mat image = media::decodeImage(readFile(path), path);  // readFile names the file when missing
   double max_value = 1.0;
   switch (image.depth()) {
     case CV_8U: max_value = 255.0; break;
@@ -67,13 +57,6 @@ cv::Mat readGrayImage(const std::string& path, PixelScale scale) {
   return y;
 }
 
-void writePng(const std::string& path, const cv::Mat& image) {
-  if (image.empty() || (image.depth() != CV_8U && image.depth() != CV_16U) ||
-      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
-    throw Error::inFile(path, 0, "PNG: expected a non-empty 8- or 16-bit image with 1, 3 or 4 channels");
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", image, png)) throw Error::inFile(path, 0, "PNG encoding failed");
-  writeFileAtomic(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
-}
+void writePng(const std::string& path, const cv::Mat& image) { writeFileAtomic(path, encodePng(image, path)); }
 
 }  // namespace evio::io

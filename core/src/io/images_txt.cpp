@@ -2,10 +2,11 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "evio/core/error.h"
+#include "evio/core/io/media_module.h"
+#include "evio/core/io/png_codec.h"
 #include "evio/core/io/text_scanner.h"
 
 namespace evio::io {
@@ -41,8 +42,7 @@ std::vector<ImageStamp> readImageList(const std::string& folder) {
 
 cv::Mat readFrame(const std::string& folder, const ImageStamp& stamp, cv::Size expected) {
   const std::string path = (fs::path(folder) / stamp.relative_path).string();
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw Error::inFile(path, 0, "missing or not a readable image");
+  cv::Mat image = media::decodeImage(readFile(path), path);  // readFile names the file when missing
   if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_BGR2GRAY);
   else if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2GRAY);
   if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
@@ -65,10 +65,7 @@ void ImageFolderWriter::append(TimeNs t_ns, const cv::Mat& image) {
     throw Error::inFile(list_.path(), 0, "frames must be appended in increasing time");
   char name[32];
   std::snprintf(name, sizeof(name), "images/frame_%08zu.png", count_);
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", image, png)) throw Error::inFile(name, 0, "PNG encoding failed");
-  writeFileAtomic((fs::path(folder_) / name).string(),
-                  std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  writeFileAtomic((fs::path(folder_) / name).string(), encodePng(image, name));
   appendSeconds(buffer_, t_ns);
   buffer_.push_back(' ');
   buffer_ += name;

@@ -73,6 +73,8 @@ GyroBiasEstimate GyroBiasWindow::estimate(const Eigen::Matrix<double, 15, 15>& P
       e.covariance = P.block<3, 3>(kIdxBg, kIdxBg);
       e.at_rest = true;
       e.rest_s = rest->durationS();
+      e.rest_b_a = x.b_a;
+      e.rest_b_a_covariance = P.block<3, 3>(kIdxBa, kIdxBa);
       rest_start_.emplace(x, P);
     }
   }

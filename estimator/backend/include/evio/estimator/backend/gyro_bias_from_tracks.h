@@ -109,6 +109,10 @@ struct GyroBiasEstimate {
   /// filter starts with their covariance as well.
   bool at_rest = false;
   double rest_s = 0.0;  ///< the readings' span, s
+  /// At rest the accelerometer bias comes from the mean force too (with the
+  /// tilt): its posterior mean, m/s², and covariance, (m/s²)².
+  Vec3 rest_b_a = Vec3::Zero();
+  Mat3 rest_b_a_covariance = Mat3::Zero();
 };
 
 /// The bundle adjustment's result (refineGyroBiasByBundleAdjustment).

@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 
 #include "evio/core/error.h"
+#include "evio/core/io/media_module.h"
 #include "sequence_arrays.h"
 
 namespace py = pybind11;
@@ -19,4 +20,6 @@ PYBIND11_MODULE(_native, m) {
     }
   });
   evio::python::addSequenceReaders(m);
+  m.def("set_media_module", &evio::io::media::setModulePath, py::arg("path"),
+        "where the media module (libevio_media.so) is, for frames in formats other than PNG");
 }

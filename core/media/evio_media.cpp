@@ -13,6 +13,10 @@
 
 #include "evio/core/io/media_module.h"
 
+#ifndef EVIO_MEDIA_BUILD_ID
+#error "EVIO_MEDIA_BUILD_ID (the build identifier both sides share) is not defined"
+#endif
+
 namespace {
 
 using evio::io::Raster;
@@ -128,7 +132,8 @@ VideoEncoder* openVideo(const std::string& path, const char* fourcc, double fps,
   return new OpenCvVideo(std::move(writer));
 }
 
-const Api kApi{evio::io::media::kAbiVersion, decodeImage, readRaster, writeGeoTiff, openVideo};
+const Api kApi{EVIO_MEDIA_BUILD_ID, sizeof(Api),        sizeof(Raster), sizeof(cv::Mat),
+               decodeImage,                readRaster,         writeGeoTiff,   openVideo};
 
 }  // namespace
 

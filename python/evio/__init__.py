@@ -30,7 +30,11 @@ import tempfile
 import yaml
 
 from ._native import Error, iter_events, iter_frames, read_event_columns, read_events, read_groundtruth, read_imu
-from ._paths import BIN_FROM_PACKAGE, VERSION
+from ._native import set_media_module as _set_media_module
+from ._paths import BIN_FROM_PACKAGE, MEDIA_FROM_PACKAGE, VERSION
+
+# Frames in formats other than PNG are decoded by the media module beside the package.
+_set_media_module(os.path.normpath(os.path.join(os.path.dirname(__file__), MEDIA_FROM_PACKAGE)))
 
 __version__ = VERSION
 __all__ = ["Error", "read_events", "read_event_columns", "iter_events", "iter_frames", "read_imu",

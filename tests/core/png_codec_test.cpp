@@ -61,7 +61,8 @@ std::string errorOf(const std::function<void()>& f) {
 /// with alpha, Adam7 interlacing, 2-bit grey. Returns the file's bytes.
 std::string libpngWrite(int width, int height, int bit_depth, int colour, bool interlaced,
                         const std::vector<std::vector<png_byte>>& rows, const std::vector<png_color>& palette = {},
-                        const std::vector<png_byte>& palette_alpha = {}) {
+                        const std::vector<png_byte>& palette_alpha = {}, const png_color_16* trans_colour = nullptr,
+                        double gamma = 0.0) {
   std::string out;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png_create_info_struct(png);
@@ -77,6 +78,8 @@ std::string libpngWrite(int width, int height, int bit_depth, int colour, bool i
   if (!palette.empty()) png_set_PLTE(png, info, palette.data(), static_cast<int>(palette.size()));
   if (!palette_alpha.empty())
     png_set_tRNS(png, info, palette_alpha.data(), static_cast<int>(palette_alpha.size()), nullptr);
+  if (trans_colour) png_set_tRNS(png, info, nullptr, 0, const_cast<png_color_16*>(trans_colour));
+  if (gamma > 0.0) png_set_gAMA(png, info, gamma);
   png_write_info(png, info);
   std::vector<png_bytep> pointers;
   for (const auto& r : rows) pointers.push_back(const_cast<png_bytep>(r.data()));
@@ -120,12 +123,47 @@ TEST(PngCodec, ExpandsBilevelPaletteAlphaAndInterlacedFilesAsImgcodecsDoes) {
   for (int y = 0; y < 11; ++y)
     for (int x = 0; x < 3 * 13; ++x) rgb[y][x] = static_cast<png_byte>(7 * x + 19 * y);
   files.push_back(libpngWrite(13, 11, 8, PNG_COLOR_TYPE_RGB, true, rgb));  // Adam7
+  // tRNS on grey: OpenCV keeps one channel; on colour it adds alpha. And a
+  // gAMA chunk, which neither applies.
+  png_color_16 grey_key{};
+  grey_key.gray = 77;
+  std::vector<std::vector<png_byte>> grey8(5, std::vector<png_byte>(9));
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 9; ++x) grey8[y][x] = static_cast<png_byte>(x % 3 == 0 ? 77 : 20 * x + y);
+  files.push_back(libpngWrite(9, 5, 8, PNG_COLOR_TYPE_GRAY, false, grey8, {}, {}, &grey_key, 0.45455));
+  grey_key.gray = 0x1234;
+  std::vector<std::vector<png_byte>> grey16(4, std::vector<png_byte>(2 * 7));
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 7; ++x) {
+      const int v = x == 2 ? 0x1234 : 9000 * x + 1700 * y + 11;
+      grey16[y][2 * x] = static_cast<png_byte>(v >> 8);  // big-endian, as in the file
+      grey16[y][2 * x + 1] = static_cast<png_byte>(v & 0xFF);
+    }
+  files.push_back(libpngWrite(7, 4, 16, PNG_COLOR_TYPE_GRAY, false, grey16, {}, {}, &grey_key));
+  grey_key.gray = 2;
+  files.push_back(libpngWrite(7, 5, 2, PNG_COLOR_TYPE_GRAY, false, two_bit, {}, {}, &grey_key));
+  png_color_16 rgb_key{};
+  rgb_key.red = 0x0102;
+  rgb_key.green = 0x0304;
+  rgb_key.blue = 0x0506;
+  std::vector<std::vector<png_byte>> rgb16(3, std::vector<png_byte>(6 * 5));
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 6 * 5; ++x) rgb16[y][x] = static_cast<png_byte>(x < 6 && y == 0 ? x + 1 : 37 * x + 91 * y);
+  files.push_back(libpngWrite(5, 3, 16, PNG_COLOR_TYPE_RGB, true, rgb16, {}, {}, &rgb_key));  // the first pixel is the key
   for (std::size_t k = 0; k < files.size(); ++k) {
     SCOPED_TRACE("file " + std::to_string(k));
     const cv::Mat theirs = imdecodeUnchanged(files[k]);
     ASSERT_FALSE(theirs.empty());
     EXPECT_TRUE(samePixels(io::decodePng(files[k], "f.png"), theirs));
   }
+}
+
+TEST(PngCodec, EncodesAViewInsideALargerImageAsImgcodecsDoes) {
+  const cv::Mat whole = pattern(40, 50, CV_16UC3);
+  const cv::Mat view = whole(cv::Rect(7, 5, 31, 22));  // rows not contiguous
+  ASSERT_FALSE(view.isContinuous());
+  EXPECT_EQ(io::encodePng(view, "v.png"), imencodePng(view));
+  EXPECT_TRUE(samePixels(io::decodePng(io::encodePng(view, "v.png"), "v.png"), view));
 }
 
 TEST(PngCodec, BrokenDataIsOneErrorNamingTheFile) {
@@ -160,21 +198,52 @@ TEST(MediaModule, DecodesOtherFormatsThroughTheModuleAsImgcodecsDoes) {
   const std::string garbage = errorOf([] { io::media::decodeImage("neither png nor jpeg", "g.bin"); });
   EXPECT_NE(garbage.find("g.bin"), std::string::npos) << garbage;
   EXPECT_NE(garbage.find("not a readable image"), std::string::npos) << garbage;
+  const std::string broken_jpeg = errorOf([] { io::media::decodeImage("\xFF\xD8\xFF then nothing", "b.jpg"); });
+  EXPECT_NE(broken_jpeg.find("b.jpg"), std::string::npos) << broken_jpeg;
+  EXPECT_NE(broken_jpeg.find("not a readable image"), std::string::npos) << broken_jpeg;
 }
 
-TEST(MediaModule, AMissingModuleIsOneErrorNamingTheFileAndThePathTried) {
-  // In a fresh process (the module is loaded once per process).
+/// Runs `body` in a fresh process (the module is loaded once per process)
+/// with EVIO_MEDIA_MODULE set to `module`; the child exits 0 when `body` does.
+void expectInFreshProcess(const char* module, bool (*body)()) {
+  const std::string style = GTEST_FLAG_GET(death_test_style);
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(
       {
-        setenv("EVIO_MEDIA_MODULE", "/nonexistent/libevio_media.so", 1);
-        const std::string message = errorOf([] { io::media::decodeImage("neither png nor jpeg", "g.jpg"); });
-        const bool names_both = message.find("g.jpg") != std::string::npos &&
-                                message.find("/nonexistent/libevio_media.so (missing)") != std::string::npos;
-        std::fprintf(stderr, "%s\n", message.c_str());
-        std::exit(names_both ? 0 : 1);
+        setenv("EVIO_MEDIA_MODULE", module, 1);
+        std::exit(body() ? 0 : 1);
       },
-      testing::ExitedWithCode(0), "EVIO_MEDIA_MODULE");
+      testing::ExitedWithCode(0), "");
+  GTEST_FLAG_SET(death_test_style, style);
+}
+
+TEST(MediaModule, AMissingModuleIsOneErrorNamingTheFileAndThePathTried) {
+  expectInFreshProcess("/nonexistent/libevio_media.so", [] {
+    const std::string message = errorOf([] { io::media::decodeImage("\xFF\xD8\xFF a JPEG's start", "g.jpg"); });
+    std::fprintf(stderr, "%s\n", message.c_str());
+    return message.find("g.jpg") != std::string::npos &&
+           message.find("/nonexistent/libevio_media.so (missing)") != std::string::npos &&
+           message.find("EVIO_MEDIA_MODULE") != std::string::npos;
+  });
+}
+
+TEST(MediaModule, ALibraryThatIsNotTheModuleIsRefusedByName) {
+  // libpng is a real shared library without the module's entry point.
+  expectInFreshProcess(PNG_LIBRARY_FILE, [] {
+    const std::string message = errorOf([] { io::media::decodeImage("\xFF\xD8\xFF a JPEG's start", "g.jpg"); });
+    std::fprintf(stderr, "%s\n", message.c_str());
+    return message.find("not an evio media module") != std::string::npos;
+  });
+}
+
+TEST(MediaModule, BytesWithoutAnImageSignatureAreRefusedWithoutTheModule) {
+  expectInFreshProcess("/nonexistent/libevio_media.so", [] {
+    const std::string garbage = errorOf([] { io::media::decodeImage("neither png nor jpeg", "g.bin"); });
+    const std::string empty = errorOf([] { io::media::decodeImage("", "e.png"); });
+    std::fprintf(stderr, "%s\n%s\n", garbage.c_str(), empty.c_str());
+    return garbage.find("no signature") != std::string::npos && empty.find("empty") != std::string::npos &&
+           garbage.find("libevio_media") == std::string::npos;
+  });
 }
 
 }  // namespace

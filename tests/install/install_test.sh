@@ -17,6 +17,13 @@ check_python() {
   found=$(cd "$scratch" && PYTHONPATH=$prefix/lib/python3/dist-packages /usr/bin/python3 -c 'import evio; print(evio.binary())') \
     || fail "import evio from $prefix"
   [[ $(realpath "$found") == $(realpath "$prefix/bin/evio") ]] || fail "the package under $prefix runs $found"
+  # A PGM frame: decoded by the media module installed beside the package.
+  mkdir -p "$scratch/pgm/images"
+  printf 'P5\n3 2\n255\n\001\002\003\004\005\006' > "$scratch/pgm/images/f.pgm"
+  echo "0.5 images/f.pgm" > "$scratch/pgm/images.txt"
+  found=$(cd "$scratch" && env -u EVIO_MEDIA_MODULE PYTHONPATH=$prefix/lib/python3/dist-packages /usr/bin/python3 -c \
+    'import evio; print([p.tolist() for t, p in evio.iter_frames("pgm")])') || fail "a PGM frame through the package under $prefix"
+  [[ $found == "[[[1, 2, 3], [4, 5, 6]]]" ]] || fail "the PGM frame read as $found"
 }
 
 # Runs the installed binary $1 in an empty folder on a short simulated sequence.

@@ -111,6 +111,26 @@ class SimulatedSequence(unittest.TestCase):
             png = np.rint(matplotlib.image.imread(os.path.join(self.seq, name)) * 255).astype(np.uint8)
             np.testing.assert_array_equal(pixels, png)
 
+    def test_frames_in_other_formats_come_through_the_media_module(self):
+        # A copy of the sequence's frames as binary PGM (P5): OpenCV reads it
+        # through the media module, which the package finds beside itself
+        # (the environment names no module here).
+        self.assertNotIn("EVIO_MEDIA_MODULE", os.environ)
+        frames = list(evio.iter_frames(self.seq))[:3]
+        folder = os.path.join(self.tmp.name, "pgm")
+        os.makedirs(os.path.join(folder, "images"), exist_ok=True)
+        with open(os.path.join(folder, "images.txt"), "w") as listing:
+            for k, (t, pixels) in enumerate(frames):
+                name = "images/frame_%08d.pgm" % k
+                with open(os.path.join(folder, name), "wb") as f:
+                    f.write(b"P5\n%d %d\n255\n" % (pixels.shape[1], pixels.shape[0]) + pixels.tobytes())
+                listing.write("%d.%09d %s\n" % (t // 1_000_000_000, t % 1_000_000_000, name))
+        back = list(evio.iter_frames(folder))
+        self.assertEqual(len(back), len(frames))
+        for (t, pixels), (t_back, pixels_back) in zip(frames, back):
+            self.assertEqual(t, t_back)
+            np.testing.assert_array_equal(pixels, pixels_back)
+
     def test_estimate_and_evaluate_match_the_binary(self):
         est = os.path.join(self.tmp.name, "est")
         status = evio.estimate(self.seq, est, method="klt-vio", config="estimator/config/sim.yaml",

@@ -20,7 +20,7 @@ namespace evio::io {
 namespace {
 
 constexpr std::size_t kSignatureBytes = 8;
-constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 28;  // 256 Mpx: far beyond any sensor or texture
+constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 30;  // OpenCV's limit (CV_IO_MAX_IMAGE_PIXELS)
 constexpr bool kLittleEndianHost = std::endian::native == std::endian::little;
 
 /// What the callbacks share with the caller: the input (or output) bytes and
@@ -49,7 +49,13 @@ void readBytes(png_structp png, png_bytep out, png_size_t count) {
 
 void writeBytes(png_structp png, png_bytep data, png_size_t count) {
   auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
-  io->output->append(reinterpret_cast<const char*>(data), count);
+  bool appended = true;
+  try {
+    io->output->append(reinterpret_cast<const char*>(data), count);
+  } catch (...) {  // no C++ exception may cross libpng's C frames
+    appended = false;
+  }
+  if (!appended) png_error(png, "out of memory");
 }
 
 void flushNothing(png_structp) {}
@@ -72,10 +78,11 @@ bool readHeader(png_structp png, png_infop info, Layout* layout) {
   const bool transparency = png_get_valid(png, info, PNG_INFO_tRNS) != 0;
   if (colour == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
   if (colour == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(png);
-  if (transparency) png_set_tRNS_to_alpha(png);
-  // Grey with alpha becomes BGRA, as in OpenCV (no two-channel images).
-  if ((colour & PNG_COLOR_MASK_COLOR) == 0 && ((colour & PNG_COLOR_MASK_ALPHA) != 0 || transparency))
-    png_set_gray_to_rgb(png);
+  // As OpenCV: tRNS becomes alpha for colour and palette images only (grey
+  // with tRNS stays one channel), and grey with alpha becomes BGRA (there are
+  // no two-channel images).
+  if (transparency && (colour & PNG_COLOR_MASK_COLOR) != 0) png_set_tRNS_to_alpha(png);
+  if (colour == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(png);
   if (depth == 16 && kLittleEndianHost) png_set_swap(png);
   png_set_bgr(png);
   png_set_interlace_handling(png);

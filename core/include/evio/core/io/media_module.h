@@ -10,10 +10,14 @@
 /// Where it is looked for:
 ///   1. `$EVIO_MEDIA_MODULE`, a path to the module file, if set (the tests
 ///      set it; nothing else is tried then);
-///   2. beside the running program's folder, `<bin>/../<libdir>/evio/`
-///      (an installed `evio`, the Debian package's, and `build/<preset>/bin/evio`);
-///   3. the configured install prefix's `<libdir>/evio/` (the Python module).
-/// No build-tree path is compiled in: an installed binary names no source folder.
+///   2. the path given to setModulePath (the Python package: relative to
+///      itself, in the build tree and once installed);
+///   3. beside the running program's folder, `<bin>/../<libdir>/evio/`
+///      (an installed `evio`, the Debian package's, and `build/<preset>/bin/evio`).
+/// No absolute path is compiled in: an installed binary names no source
+/// folder, and never loads the module of another installation. A module is
+/// taken only from the build that made it (the build identifier and the
+/// layouts of the types it exchanges must match).
 
 #include <opencv2/core/mat.hpp>
 #include <cstddef>
@@ -37,7 +41,13 @@ class VideoEncoder {
 /// The module's table of entry points. Errors come back as false (or null)
 /// with a message; the caller turns them into evio::Error naming its file.
 struct Api {
-  int abi_version;
+  /// The build identifier (evio and OpenCV versions, compiler: the macro
+  /// EVIO_MEDIA_BUILD_ID that core/CMakeLists.txt gives both sides) and the
+  /// layouts the two sides must share; checked before any other member is used.
+  const char* build_id;
+  std::size_t api_size;
+  std::size_t raster_size;
+  std::size_t mat_size;
   /// Any format OpenCV's imdecode reads, with IMREAD_UNCHANGED.
   bool (*decode_image)(const unsigned char* bytes, std::size_t size, cv::Mat* image, std::string* error);
   /// Band `band` (1-based) as CV_32FC1 with its geotransform and no-data value.
@@ -48,8 +58,6 @@ struct Api {
   VideoEncoder* (*open_video)(const std::string& path, const char* fourcc, double fps, int width, int height);
 };
 
-/// Bumped whenever Api changes, so a module from another build is refused.
-inline constexpr int kAbiVersion = 1;
 /// The module's one exported symbol: `extern "C" const Api* evio_media_api()`.
 inline constexpr const char* kEntryPoint = "evio_media_api";
 
@@ -58,9 +66,15 @@ inline constexpr const char* kEntryPoint = "evio_media_api";
 /// module cannot be found or loaded.
 const Api& api(const std::string& needed_for);
 
+/// Where to look for the module after $EVIO_MEDIA_MODULE (the Python package
+/// calls it at import). Has no effect once the module is loaded.
+void setModulePath(const std::string& path);
+
 /// Decodes an image file's bytes as OpenCV's imdecode(IMREAD_UNCHANGED):
-/// PNG here (png_codec.h), any other format through the module. Throws Error
-/// naming `path` when the bytes cannot be decoded.
+/// PNG here (png_codec.h), the other formats OpenCV reads through the module.
+/// Bytes with no image signature OpenCV knows are refused here, without
+/// loading the module. Throws Error naming `path` when the bytes cannot be
+/// decoded.
 cv::Mat decodeImage(std::string_view bytes, const std::string& path);
 
 }  // namespace evio::io::media

@@ -15,9 +15,9 @@ namespace evio::io {
 bool isPng(std::string_view bytes);
 
 /// Decodes a PNG as OpenCV's imdecode(IMREAD_UNCHANGED) does: grey → CV_8UC1 or
-/// CV_16UC1 (depths below 8 expanded to 8 bits), grey with alpha → 4 channels,
-/// colour → BGR, colour with alpha (or a palette with transparency) → BGRA;
-/// 16-bit samples in host order. Throws Error naming `path` when the data is
+/// CV_16UC1 (depths below 8 expanded to 8 bits; a tRNS chunk ignored), grey
+/// with alpha → 4 channels, colour or palette → BGR, with alpha or tRNS →
+/// BGRA; 16-bit samples in host order; at most 2³⁰ pixels, as OpenCV. Throws Error naming `path` when the data is
 /// not a valid PNG (bad signature, CRC, truncation, unsupported layout).
 cv::Mat decodePng(std::string_view bytes, const std::string& path);
 

@@ -10,6 +10,8 @@
 // DAVIS240 reference noise with zero-bias start drifts further than that).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -90,31 +92,49 @@ TEST_F(PipelineSimulated, EkltVio) {
 }
 
 // Features tracked on 1, 2 or 3 threads (frontend.threads), the backend on
-// the reading thread or its own (backend_thread): the estimate files and the
-// counts are the same bytes (eklt_tracker.h: fixed partition, merge in the
-// single-thread order; pipeline.cpp: items handed to the backend in order).
-TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCount) {
+// the reading thread or its own (backend_thread), event chunks tracked one
+// by one or in segments (frontend.segment_s: 0, the default 0.05 s, up to a
+// second, i.e. all between two frames): the estimate files and the counts
+// are the same bytes (eklt_tracker.h: fixed partition, merge in the
+// single-thread order; stages.h: held inputs leave in their order;
+// pipeline.cpp: items handed to the backend in order). timing.txt's rows are
+// the same for the same segments (its feature count is read when a row is
+// written, and segments move what the tracker has seen by then).
+TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCountAndSegment) {
+  struct Config {
+    int threads;
+    bool backend_thread;
+    double segment_s;
+  };
+  const double kDefault = FrontendOptions().segment_s;
+  const Config configs[] = {{1, false, kDefault}, {2, false, kDefault}, {3, false, kDefault}, {1, true, kDefault},
+                            {2, true, kDefault},  {1, false, 0.0},      {2, false, 0.0},      {2, true, 1.0}};
   std::vector<std::string> outs;
   std::vector<PipelineCounts> counts;
-  const std::pair<int, bool> configs[] = {{1, false}, {2, false}, {3, false}, {1, true}, {2, true}};
-  for (const auto& [threads, backend_thread] : configs) {
+  for (const Config& c : configs) {
     PipelineOptions o = fromGroundTruth("eklt-vio");
-    o.frontend.threads = threads;
-    o.backend_thread = backend_thread;
+    o.frontend.threads = c.threads;
+    o.backend_thread = c.backend_thread;
+    o.frontend.segment_s = c.segment_s;
     o.frontend.eklt.position_covariance = true;
-    outs.push_back(dir_->file("eklt_threads_" + std::to_string(threads) + (backend_thread ? "_bt" : "")));
+    outs.push_back(dir_->file("eklt_threads_" + std::to_string(c.threads) + (c.backend_thread ? "_bt" : "") + "_seg" +
+                              std::to_string(c.segment_s)));
     const PipelineResult r = runPipeline(sequence(), o, outs.back());
     ASSERT_TRUE(r.status.ok()) << r.status.cause;
     ASSERT_GT(r.counts.measurement_sets, 60u);
     counts.push_back(r.counts);
   }
   for (std::size_t k = 1; k < outs.size(); ++k) {
-    const std::string config = std::to_string(configs[k].first) + " threads" + (configs[k].second ? " + backend thread" : "");
+    const std::string config = std::to_string(configs[k].threads) + " threads" +
+                               (configs[k].backend_thread ? " + backend thread" : "") + ", segments of " +
+                               std::to_string(configs[k].segment_s) + " s";
     for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
       EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[k] + "/" + file)) << file << ", " << config;
     // timing.txt: the same rows, events and features (the processing time is the machine's).
-    EXPECT_TRUE(test::timingWithoutClock(outs[0] + "/timing.txt") == test::timingWithoutClock(outs[k] + "/timing.txt"))
-        << config;
+    if (configs[k].segment_s == configs[0].segment_s) {
+      EXPECT_TRUE(test::timingWithoutClock(outs[0] + "/timing.txt") == test::timingWithoutClock(outs[k] + "/timing.txt"))
+          << config;
+    }
     EXPECT_EQ(counts[0].events, counts[k].events) << config;
     EXPECT_EQ(counts[0].track_points, counts[k].track_points) << config;
     EXPECT_EQ(counts[0].measurement_sets, counts[k].measurement_sets) << config;
@@ -130,17 +150,19 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCount) {
 // same bytes too.)
 TEST_F(PipelineSimulated, HasteVioEstimatesAreByteIdenticalForAnyThreadCount) {
   std::vector<std::string> outs;
-  for (int threads : {1, 2}) {
+  for (int threads : {1, 2, 0}) {  // 0: one thread, each event chunk alone (no segments)
     PipelineOptions o = fromGroundTruth("haste-vio");
-    o.frontend.threads = threads;
+    o.frontend.threads = std::max(threads, 1);
     o.backend_thread = threads > 1;
+    if (threads == 0) o.frontend.segment_s = 0.0;
     outs.push_back(dir_->file("haste_threads_" + std::to_string(threads)));
     const PipelineResult r = runPipeline(sequence(), o, outs.back());
     ASSERT_GT(r.counts.measurement_sets, 30u) << r.status.cause;
     ASSERT_GT(r.counts.track_points, 1000u);
   }
-  for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
-    EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[1] + "/" + file)) << file;
+  for (std::size_t k = 1; k < outs.size(); ++k)
+    for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
+      EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[k] + "/" + file)) << file << ", run " << k;
   const test::TimingColumns timing = test::timingWithoutClock(outs[0] + "/timing.txt");
   EXPECT_TRUE(test::anyFeatures(timing));
   EXPECT_TRUE(timing == test::timingWithoutClock(outs[1] + "/timing.txt"));

@@ -67,6 +67,55 @@ TrackPoints feedScene(Tracker& tracker) {
   return points;
 }
 
+/// The scene's outputs input by input: one list of points per event chunk
+/// and per frame. With `chunks_per_segment` > 0 the chunks between two frames
+/// go to addEventChunks in segments of that many chunks (the pipeline's
+/// FrontendStage), else one by one through addEvents.
+template <class Tracker>
+std::vector<TrackPoints> feedSceneByInput(Tracker& tracker, std::size_t chunks_per_segment) {
+  const Scene& scene = Scene::get();
+  std::vector<TrackPoints> outputs;
+  std::size_t next = 0;
+  for (std::size_t f = 0; f < scene.frames.size(); ++f) {
+    const TimeNs t_frame = secondsToNs(static_cast<double>(f) * Scene::kFrameDtS);
+    const std::size_t end = scene.events.lowerBound(t_frame);
+    std::vector<std::size_t> chunk_ends;
+    for (std::size_t b = next; b < end; b += 700) chunk_ends.push_back(std::min(end, b + 700));
+    if (chunks_per_segment == 0) {
+      std::size_t b = next;
+      for (const std::size_t e : chunk_ends) {
+        tracker.addEvents(scene.events, b, e);
+        tracker.drainTrackPoints(outputs.emplace_back());
+        b = e;
+      }
+    } else {
+      for (std::size_t k = 0; k < chunk_ends.size(); k += chunks_per_segment) {
+        // The segment's events in an array of their own, as FrontendStage holds them.
+        const std::size_t first = k == 0 ? next : chunk_ends[k - 1];
+        const std::size_t last = std::min(chunk_ends.size(), k + chunks_per_segment);
+        EventArray segment;
+        for (std::size_t i = first; i < chunk_ends[last - 1]; ++i)
+          segment.push_back(scene.events.t()[i], scene.events.x()[i], scene.events.y()[i], scene.events.p()[i] != 0);
+        std::vector<std::size_t> ends;
+        for (std::size_t j = k; j < last; ++j) ends.push_back(chunk_ends[j] - first);
+        TrackPoints points;
+        std::vector<std::size_t> point_ends;
+        tracker.addEventChunks(segment, ends, points, point_ends);
+        EXPECT_EQ(point_ends.size(), ends.size());
+        std::size_t b = 0;
+        for (const std::size_t e : point_ends) {
+          outputs.emplace_back(points.begin() + static_cast<std::ptrdiff_t>(b), points.begin() + static_cast<std::ptrdiff_t>(e));
+          b = e;
+        }
+      }
+    }
+    next = end;
+    tracker.addFrame(t_frame, scene.frames[f]);
+    tracker.drainTrackPoints(outputs.emplace_back());
+  }
+  return outputs;
+}
+
 Camera sceneCamera() { return Camera::create("pinhole", kWidth, kHeight, Vec4(120, 120, 79.5, 59.5), VecX()); }
 
 TrackPoints track(int threads, EkltTiming* timing = nullptr, bool single_precision = true) {
@@ -154,6 +203,56 @@ TEST(HasteThreads, TrackPointsAreTheSameBitsForAnyThreadCount) {
   EXPECT_GE(lost, 5);
   EXPECT_GT(born, 30);
   for (int threads : {2, 3, 7}) expectSamePoints(one, trackHaste(threads), threads);
+}
+
+EkltOptions sceneEkltOptions() {
+  EkltOptions options;
+  options.batch_contrast_threshold = kContrast;
+  options.max_features = 30;
+  options.min_features = 24;
+  options.harris_quality_level = 0.02;
+  options.position_covariance = true;
+  return options;
+}
+
+TEST(EkltThreads, ChunksTrackedAsSegmentsGiveEachChunkItsOwnPointsForAnyThreadCount) {
+  // The pipeline's segments (FrontendOptions::segment_s): many chunks in one
+  // run of the threads must give every chunk exactly the points it gives
+  // alone, whatever the segment's length (1, 3 or 100 chunks; 100 takes all
+  // the chunks between two frames).
+  EkltTracker reference(sceneEkltOptions(), sceneCamera(), std::nullopt, 1);
+  const std::vector<TrackPoints> alone = feedSceneByInput(reference, 0);
+  std::size_t points = 0, chunks_with_points = 0;
+  for (const TrackPoints& o : alone) {
+    points += o.size();
+    chunks_with_points += !o.empty();
+  }
+  EXPECT_GT(points, 2000u);
+  EXPECT_GT(chunks_with_points, 30u);
+  for (const int threads : {1, 2, 3})
+    for (const std::size_t per_segment : {std::size_t{1}, std::size_t{3}, std::size_t{100}}) {
+      SCOPED_TRACE(std::to_string(threads) + " threads, " + std::to_string(per_segment) + " chunks per segment");
+      EkltTracker tracker(sceneEkltOptions(), sceneCamera(), std::nullopt, threads);
+      const std::vector<TrackPoints> segmented = feedSceneByInput(tracker, per_segment);
+      ASSERT_EQ(segmented.size(), alone.size());
+      for (std::size_t k = 0; k < alone.size(); ++k) expectSamePoints(alone[k], segmented[k], threads);
+    }
+}
+
+TEST(HasteThreads, ChunksTrackedAsSegmentsGiveEachChunkItsOwnPointsForAnyThreadCount) {
+  HasteOptions options;
+  options.max_features = 30;
+  options.min_features = 24;
+  options.harris_quality_level = 0.02;
+  HasteTracker reference(options, sceneCamera(), 1);
+  const std::vector<TrackPoints> alone = feedSceneByInput(reference, 0);
+  for (const int threads : {1, 2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    HasteTracker tracker(options, sceneCamera(), threads);
+    const std::vector<TrackPoints> segmented = feedSceneByInput(tracker, 100);
+    ASSERT_EQ(segmented.size(), alone.size());
+    for (std::size_t k = 0; k < alone.size(); ++k) expectSamePoints(alone[k], segmented[k], threads);
+  }
 }
 
 // The single-thread output of this scene, pinned for both precisions of

@@ -1,5 +1,7 @@
 #include "evio/estimator/frontend/chunk_points.h"
 
+#include <limits>
+
 #include "evio/core/error.h"
 
 namespace evio::estimator {
@@ -28,6 +30,39 @@ void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackP
     out.push_back(best->point);
     ++heads[best_part];
   }
+  for (std::vector<ChunkPoint>* p : parts) p->clear();
+}
+
+void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, const std::vector<std::size_t>& chunk_ends,
+                      TrackPoints& out, std::vector<std::size_t>& point_ends) {
+  require(parts.size() <= 256, "mergeChunkPoints: at most 256 parts");
+  std::size_t chunk = 0;
+  // Closes the chunks that end at or before `event` (all of them for SIZE_MAX).
+  const auto closeChunksBefore = [&](std::size_t event) {
+    while (chunk < chunk_ends.size() && chunk_ends[chunk] <= event) {
+      point_ends.push_back(out.size());
+      ++chunk;
+    }
+  };
+  std::size_t heads[256] = {};
+  while (true) {
+    const ChunkPoint* best = nullptr;
+    std::size_t best_part = 0;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const std::vector<ChunkPoint>& pts = *parts[k];
+      if (heads[k] == pts.size()) continue;
+      const ChunkPoint& c = pts[heads[k]];
+      if (!best || c.event < best->event || (c.event == best->event && c.slot < best->slot)) {
+        best = &c;
+        best_part = k;
+      }
+    }
+    if (!best) break;
+    closeChunksBefore(best->event);
+    out.push_back(best->point);
+    ++heads[best_part];
+  }
+  closeChunksBefore(std::numeric_limits<std::size_t>::max());
   for (std::vector<ChunkPoint>* p : parts) p->clear();
 }
 

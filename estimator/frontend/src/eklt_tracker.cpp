@@ -262,6 +262,18 @@ void EkltTracker::splat(Slot& s, double x, double y, bool positive, TimeNs t_ns)
 }
 
 void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::size_t end) {
+  trackInParts(events, begin, end);
+  mergeChunkPoints();
+}
+
+void EkltTracker::addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends,
+                                 TrackPoints& out, std::vector<std::size_t>& point_ends) {
+  drainTrackPoints(out);
+  trackInParts(events, 0, chunk_ends.empty() ? 0 : chunk_ends.back());
+  estimator::mergeChunkPoints(part_points_, chunk_ends, out, point_ends);
+}
+
+void EkltTracker::trackInParts(const EventArray& events, std::size_t begin, std::size_t end) {
   const auto& x = events.x();
   const auto& y = events.y();
   for (std::size_t i = begin; i < end; ++i)
@@ -283,7 +295,6 @@ void EkltTracker::addEvents(const EventArray& events, std::size_t begin, std::si
     timing_.batches_dropped += part->timing.batches_dropped;
     part->timing = EkltTiming{};
   }
-  mergeChunkPoints();
 }
 
 void EkltTracker::trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end) {

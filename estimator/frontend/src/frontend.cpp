@@ -15,6 +15,7 @@ void FrontendOptions::validate() const {
   requireField(image_source == "frames" || image_source == "reconstructed", "image_source",
                "must be frames or reconstructed (got '" + image_source + "')");
   requireField(threads >= 1 && threads <= 64, "threads", "must be in [1, 64]");
+  requireField(segment_s >= 0.0 && segment_s <= 1.0, "segment_s", "must be in [0, 1] s");
   validateSection("prefilter", prefilter);
   validateSection("eklt", eklt);
   validateSection("klt", klt);
@@ -74,6 +75,19 @@ void Frontend::addEvents(const EventArray& events) {
     }
     begin = end;
   }
+}
+
+bool Frontend::tracksEventChunks() const {
+  return !reconstructor_ && !(options_.tracker == "eklt" && options_.eklt.imu_prediction);
+}
+
+void Frontend::addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
+                              std::vector<std::size_t>& point_ends) {
+  require(tracksEventChunks(), "Frontend::addEventChunks: the tracker takes more than events between chunks");
+  events_ += chunk_ends.empty() ? 0 : chunk_ends.back();
+  const std::size_t begin = out.size();
+  tracker_->addEventChunks(events, chunk_ends, out, point_ends);
+  if (probe_) probe_->observe(out, begin);
 }
 
 void Frontend::drainTrackPoints(TrackPoints& out) {

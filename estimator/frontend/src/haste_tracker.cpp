@@ -174,7 +174,21 @@ void HasteTracker::onUpdate(Part& part, int index, HasteFeature::Update update, 
 }
 
 void HasteTracker::addEvents(const EventArray& events, std::size_t begin, std::size_t end) {
-  const auto& t = events.t();
+  trackInParts(events, begin, end);
+  mergeChunkPoints(part_points_, out_);
+  afterTracking(events, begin, end);
+}
+
+void HasteTracker::addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends,
+                                  TrackPoints& out, std::vector<std::size_t>& point_ends) {
+  drainTrackPoints(out);
+  const std::size_t end = chunk_ends.empty() ? 0 : chunk_ends.back();
+  trackInParts(events, 0, end);
+  mergeChunkPoints(part_points_, chunk_ends, out, point_ends);
+  afterTracking(events, 0, end);
+}
+
+void HasteTracker::trackInParts(const EventArray& events, std::size_t begin, std::size_t end) {
   const auto& x = events.x();
   const auto& y = events.y();
   for (std::size_t i = begin; i < end; ++i) {
@@ -193,9 +207,15 @@ void HasteTracker::addEvents(const EventArray& events, std::size_t begin, std::s
     counters_.jumps += part->counters.jumps;
     part->counters = HasteCounters{};
   }
-  mergeChunkPoints(part_points_, out_);
+}
+
+void HasteTracker::afterTracking(const EventArray& events, std::size_t begin, std::size_t end) {
   // The history is read only when a feature is seeded (addFrame): recorded
-  // after the chunk was tracked, it is the same as recorded event by event.
+  // after the chunk (or a segment of chunks) was tracked, it is the same as
+  // recorded event by event.
+  const auto& t = events.t();
+  const auto& x = events.x();
+  const auto& y = events.y();
   for (std::size_t i = begin; i < end; ++i) recordHistory(t[i], x[i], y[i]);
   counters_.events += end - begin;
 }

@@ -106,6 +106,8 @@ class PipelineRun {
   void setupStages();
   void loop();
   void runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs);
+  /// At the end of the data: what the frontend still holds (a segment) goes through the synchroniser.
+  void finishFrontStages(std::vector<BackendInput>& backend_inputs);
   void takeSnapshot(ItemSnapshot& snapshot) const;
   void consume(BackendWork& work);
   void afterItem(const ItemSnapshot& snapshot);
@@ -309,6 +311,19 @@ void PipelineRun::runFrontStages(SequenceItem& item, std::vector<BackendInput>& 
   if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
 }
 
+void PipelineRun::finishFrontStages(std::vector<BackendInput>& backend_inputs) {
+  PipelineStageCpu& cpu = result_.cpu;
+  StageCpuSplit& split = reading_cpu_;
+  split.begin();
+  StageTimer timer(&result_.times.frontend_s);
+  tracked_.clear();
+  const double waited0 = frontend_->trackerParallelCpu().wait_s;
+  frontend_->finish(tracked_);
+  split.lap(&cpu.tracking_s, frontend_->trackerParallelCpu().wait_s - waited0);
+  for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs);
+  split.lap(&cpu.sync_s);
+}
+
 void PipelineRun::takeSnapshot(ItemSnapshot& s) const {
   s.t_now = t_now_;
   s.events_read = reader_->eventsRead();
@@ -431,6 +446,16 @@ void PipelineRun::loop() {
     BackendWork& work = handoff ? handoff->slot() : inline_work_;
     work.inputs.clear();
     runFrontStages(item, work.inputs);
+    takeSnapshot(work.snapshot);
+    if (handoff)
+      handoff->push();
+    else
+      consume(work);
+  }
+  if (frontend_ && frontend_->holding() && !stopped_.load() && !(handoff && handoff->failed())) {
+    BackendWork& work = handoff ? handoff->slot() : inline_work_;
+    work.inputs.clear();
+    finishFrontStages(work.inputs);
     takeSnapshot(work.snapshot);
     if (handoff)
       handoff->push();

@@ -26,7 +26,9 @@ void PrefilterStage::process(SequenceItem& in, std::vector<SequenceItem>& out) {
 // --- FrontendStage -------------------------------------------------------------------
 
 FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera)
-    : frontend_(options, camera.camera, camera.T_B_C) {}
+    : frontend_(options, camera.camera, camera.T_B_C) {
+  if (options.segment_s > 0.0 && frontend_.tracksEventChunks()) segment_ns_ = secondsToNs(options.segment_s);
+}
 
 const EkltTiming* FrontendStage::ekltTiming() const {
   const auto* eklt = dynamic_cast<const EkltTracker*>(&frontend_.tracker());
@@ -34,6 +36,60 @@ const EkltTiming* FrontendStage::ekltTiming() const {
 }
 
 void FrontendStage::process(SequenceItem& in, std::vector<FrontendOutput>& out) {
+  if (segment_ns_ > 0) {
+    const bool holdable = in.kind == SequenceItem::Kind::kEvents ||
+                          (in.kind == SequenceItem::Kind::kImu && !held_.empty());
+    if (holdable) {
+      if (hold(in)) flushSegment(out);
+      return;
+    }
+    flushSegment(out);  // a frame or range reading: the events before it are tracked first
+  }
+  processNow(in, out);
+}
+
+bool FrontendStage::hold(SequenceItem& in) {
+  Held& h = held_.emplace_back();
+  h.output.kind = in.kind;
+  h.output.t_ns = in.t_ns;
+  if (in.kind == SequenceItem::Kind::kEvents) {
+    segment_events_.append(in.events);
+    h.output.events = in.events.size();
+    h.events_end = segment_events_.size();
+  } else {
+    // The trackers that take segments ignore the IMU: its place among the
+    // events does not matter to them.
+    ImuSample camera_clock = in.imu;
+    camera_clock.t_ns = in.t_ns;
+    frontend_.addImu(camera_clock);
+    h.output.imu = in.imu;
+  }
+  return in.t_ns - held_.front().output.t_ns >= segment_ns_ || segment_events_.size() >= kMaxSegmentEvents;
+}
+
+void FrontendStage::flushSegment(std::vector<FrontendOutput>& out) {
+  if (held_.empty()) return;
+  chunk_ends_.clear();
+  point_ends_.clear();
+  segment_points_.clear();
+  for (const Held& h : held_)
+    if (h.output.kind == SequenceItem::Kind::kEvents) chunk_ends_.push_back(h.events_end);
+  frontend_.addEventChunks(segment_events_, chunk_ends_, segment_points_, point_ends_);
+  std::size_t chunk = 0, begin = 0;
+  for (Held& h : held_) {
+    if (h.output.kind == SequenceItem::Kind::kEvents) {
+      const std::size_t end = point_ends_[chunk++];
+      h.output.points.assign(segment_points_.begin() + static_cast<std::ptrdiff_t>(begin),
+                             segment_points_.begin() + static_cast<std::ptrdiff_t>(end));
+      begin = end;
+    }
+    out.push_back(std::move(h.output));
+  }
+  held_.clear();
+  segment_events_.clear();
+}
+
+void FrontendStage::processNow(SequenceItem& in, std::vector<FrontendOutput>& out) {
   FrontendOutput& o = out.emplace_back();
   o.kind = in.kind;
   o.t_ns = in.t_ns;

@@ -74,6 +74,8 @@ class EkltTracker final : public FeatureTracker {
   void addFrame(TimeNs t_ns, const cv::Mat& image) override;
   using FeatureTracker::addEvents;
   void addEvents(const EventArray& events, std::size_t begin, std::size_t end) override;
+  void addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
+                      std::vector<std::size_t>& point_ends) override;
   void addImu(const ImuSample& sample) override;
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
@@ -105,6 +107,9 @@ class EkltTracker final : public FeatureTracker {
   struct Part;
   void splat(Slot& s, double x, double y, bool positive, TimeNs t_ns);
   void trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end);
+  /// Events [begin, end) through every part (one run of the threads); their
+  /// points stay in the parts for the merge.
+  void trackInParts(const EventArray& events, std::size_t begin, std::size_t end);
   void mergeChunkPoints();
   void optimise(Part& part, int slot_index, std::size_t event_index);
   /// The batch's solution from p0, re-solved from the reversed flow when

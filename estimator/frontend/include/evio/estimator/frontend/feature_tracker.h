@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <string_view>
+#include <vector>
 
 #include <opencv2/core/mat.hpp>
 
@@ -31,6 +32,23 @@ class FeatureTracker {
   /// frame-only trackers.
   virtual void addEvents(const EventArray& events, std::size_t begin, std::size_t end) = 0;
   void addEvents(const EventArray& events) { addEvents(events, 0, events.size()); }
+
+  /// Events [0, chunk_ends.back()) that arrived as the consecutive chunks
+  /// [0, e0), [e0, e1), … of one segment: the same as addEvents and
+  /// drainTrackPoints chunk by chunk (the points of chunk j go to `out`,
+  /// out.size() after them to `point_ends`), with nothing else in between.
+  /// Trackers with features in parallel track the whole segment in one run
+  /// of their threads; this default goes chunk by chunk.
+  virtual void addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
+                              std::vector<std::size_t>& point_ends) {
+    std::size_t begin = 0;
+    for (const std::size_t end : chunk_ends) {
+      addEvents(events, begin, end);
+      drainTrackPoints(out);
+      point_ends.push_back(out.size());
+      begin = end;
+    }
+  }
 
   /// One gyro/accelerometer sample (used for feature prediction when enabled).
   virtual void addImu(const ImuSample& sample) = 0;

@@ -29,6 +29,14 @@ struct FrontendOptions {
   /// Threads tracking features in parallel (EKLT and HASTE; KLT uses one).
   /// The output is byte-identical for any value (eklt_tracker.h).
   int threads = 1;
+  /// The pipeline tracks the event chunks of up to this span of data (s) in
+  /// one call (FeatureTracker::addEventChunks), holding the inputs between
+  /// them, so that the threads share the work of many chunks instead of one
+  /// IMU period's; the outputs keep their order, so the estimates do not
+  /// depend on it, only the latency grows by up to this span. Applies where
+  /// nothing between the chunks reaches the tracker (EKLT or HASTE on sensor
+  /// frames, no gyro prediction); 0: every chunk alone.
+  double segment_s = 0.05;
   EventPrefilterOptions prefilter;  ///< for the pre-filter that runs before the frontend
   EkltOptions eklt;
   KltOptions klt;
@@ -41,6 +49,7 @@ struct FrontendOptions {
     v("tracker", tracker, "eklt, klt or haste");
     v("image_source", image_source, "frames or reconstructed");
     v("threads", threads, "threads tracking features in parallel (EKLT, HASTE), same output for any value");
+    v("segment_s", segment_s, "event chunks of up to this span tracked in one call (0: each alone), same estimates");
     v("prefilter", prefilter, "event pre-filters");
     v("eklt", eklt, "EKLT tracker");
     v("klt", klt, "KLT tracker");
@@ -77,6 +86,14 @@ class Frontend {
 
   /// Appends the track points since the last call (the lag probe sees them too).
   void drainTrackPoints(TrackPoints& out);
+  /// True when the events of several chunks may be tracked in one call:
+  /// nothing but events reaches the tracker between them (no reconstruction,
+  /// no gyro prediction).
+  bool tracksEventChunks() const;
+  /// The chunks [0, e0), [e0, e1), … of `events` (FeatureTracker::addEventChunks):
+  /// the same as addEvents and drainTrackPoints chunk by chunk.
+  void addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
+                      std::vector<std::size_t>& point_ends);
   /// The event tracker's lag estimated from the frames (track_lag.estimate,
   /// EKLT and HASTE on sensor frames); nullopt while there are too few samples.
   std::optional<TrackLag> trackLag() const { return probe_ ? probe_->lag() : std::nullopt; }

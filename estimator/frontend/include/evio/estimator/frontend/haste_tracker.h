@@ -55,6 +55,8 @@ class HasteTracker final : public FeatureTracker {
   void addFrame(TimeNs t_ns, const cv::Mat& image) override;
   using FeatureTracker::addEvents;
   void addEvents(const EventArray& events, std::size_t begin, std::size_t end) override;
+  void addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
+                      std::vector<std::size_t>& point_ends) override;
   void addImu(const ImuSample&) override {}
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
@@ -75,6 +77,11 @@ class HasteTracker final : public FeatureTracker {
   struct Part;
   Part& partOf(int index) { return *parts_[static_cast<std::size_t>(index) % parts_.size()]; }
   void trackChunk(Part& part, const EventArray& events, std::size_t begin, std::size_t end);
+  /// Events [begin, end) through every part (one run of the threads); their
+  /// points stay in the parts for the merge.
+  void trackInParts(const EventArray& events, std::size_t begin, std::size_t end);
+  /// Records the history of events [begin, end), once they are tracked.
+  void afterTracking(const EventArray& events, std::size_t begin, std::size_t end);
   PixelRect rangeRect(double x, double y) const;
   int freeSlot() const;
   void seed(int index, const Vec2& uv, TimeNs t_ns, double theta);

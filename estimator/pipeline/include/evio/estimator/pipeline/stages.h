@@ -62,10 +62,21 @@ class PrefilterStage : public Stage<SequenceItem, SequenceItem> {
 
 /// The tracker (EKLT or KLT, with the optional reconstruction): events and
 /// frames in, track points out; IMU samples feed its gyro prediction.
+///
+/// Segments (FrontendOptions::segment_s): where the tracker takes nothing
+/// but events between chunks, event and IMU inputs are held until their
+/// span reaches segment_s (or a frame or range reading comes, or the data
+/// end: finish), the held chunks are tracked in one call, and the held
+/// inputs leave in their order, each event input with its own chunk's
+/// points: the next stages see exactly what they would see input by input.
 class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
  public:
   FrontendStage(const FrontendOptions& options, const CameraSensor& camera);
   void process(SequenceItem& in, std::vector<FrontendOutput>& out) override;
+  /// At the end of the data: the held inputs leave.
+  void finish(std::vector<FrontendOutput>& out) { flushSegment(out); }
+  /// Inputs held in a segment, waiting for finish() or the next input.
+  bool holding() const { return !held_.empty(); }
   std::uint64_t numFrames() const { return frames_; }
   /// The EKLT tracker's own time split; null for the other trackers.
   const EkltTiming* ekltTiming() const;
@@ -75,8 +86,25 @@ class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
   std::optional<TrackLag> trackLag() const { return frontend_.trackLag(); }
 
  private:
+  void processNow(SequenceItem& in, std::vector<FrontendOutput>& out);
+  /// Holds an event or IMU input; true when the segment is full.
+  bool hold(SequenceItem& in);
+  void flushSegment(std::vector<FrontendOutput>& out);
+
+  /// A held input: its output, and for events the end of its chunk in segment_events_.
+  struct Held {
+    FrontendOutput output;
+    std::size_t events_end = 0;
+  };
+  static constexpr std::size_t kMaxSegmentEvents = std::size_t{1} << 20;  // memory bound at any event rate
+
   Frontend frontend_;
   std::uint64_t frames_ = 0;
+  TimeNs segment_ns_ = 0;  // 0: no segments
+  std::vector<Held> held_;
+  EventArray segment_events_;
+  std::vector<std::size_t> chunk_ends_, point_ends_;
+  TrackPoints segment_points_;
 };
 
 /// Asynchronous track points → measurement sets (synchronizer.h); IMU and

@@ -81,6 +81,9 @@ class PipelineSimulated : public ::testing::Test {
     EXPECT_LT(err, 0.10) << name;
   }
 
+  static std::string file(const std::string& name) { return dir_->file(name); }
+  static void expectSameOutputsForAnyThreadCountAndSegment(const std::string& name, bool diverge);
+
   static test::TempDir* dir_;
 };
 
@@ -93,14 +96,15 @@ TEST_F(PipelineSimulated, EkltVio) {
 
 // Features tracked on 1, 2 or 3 threads (frontend.threads), the backend on
 // the reading thread or its own (backend_thread), event chunks tracked one
-// by one or in segments (frontend.segment_s: 0, the default 0.05 s, up to a
-// second, i.e. all between two frames): the estimate files and the counts
-// are the same bytes (eklt_tracker.h: fixed partition, merge in the
-// single-thread order; stages.h: held inputs leave in their order;
-// pipeline.cpp: items handed to the backend in order). timing.txt's rows are
-// the same for the same segments (its feature count is read when a row is
-// written, and segments move what the tracker has seen by then).
-TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCountAndSegment) {
+// by one or, with threads, in segments (frontend.segment_s: 0, 0.01 and
+// 0.02 s, which close on time between the 46 ms frames, the default 0.05 s
+// and 1 s, which close at frames): every output file but timing.txt's clock
+// and the counts are the same bytes (eklt_tracker.h: fixed partition, merge
+// in the single-thread order; stages.h: held inputs leave in their order;
+// pipeline.cpp: one backend work per input, with the snapshot taken when it
+// was read). `diverge` caps the velocity so that the backend diverges at
+// 0.14 m/s and the run stops there: the same item for every configuration.
+void PipelineSimulated::expectSameOutputsForAnyThreadCountAndSegment(const std::string& name, bool diverge) {
   struct Config {
     int threads;
     bool backend_thread;
@@ -108,7 +112,8 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCountAndSe
   };
   const double kDefault = FrontendOptions().segment_s;
   const Config configs[] = {{1, false, kDefault}, {2, false, kDefault}, {3, false, kDefault}, {1, true, kDefault},
-                            {2, true, kDefault},  {1, false, 0.0},      {2, false, 0.0},      {2, true, 1.0}};
+                            {2, true, kDefault},  {2, false, 0.0},      {2, false, 0.01},     {2, true, 0.02},
+                            {2, false, 1.0}};
   std::vector<std::string> outs;
   std::vector<PipelineCounts> counts;
   for (const Config& c : configs) {
@@ -117,11 +122,18 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCountAndSe
     o.backend_thread = c.backend_thread;
     o.frontend.segment_s = c.segment_s;
     o.frontend.eklt.position_covariance = true;
-    outs.push_back(dir_->file("eklt_threads_" + std::to_string(c.threads) + (c.backend_thread ? "_bt" : "") + "_seg" +
-                              std::to_string(c.segment_s)));
+    if (diverge) o.backend.max_velocity_mps = 0.14;
+    outs.push_back(file(name + "_" + std::to_string(c.threads) + (c.backend_thread ? "_bt" : "") + "_seg" +
+                                std::to_string(c.segment_s)));
     const PipelineResult r = runPipeline(sequence(), o, outs.back());
-    ASSERT_TRUE(r.status.ok()) << r.status.cause;
-    ASSERT_GT(r.counts.measurement_sets, 60u);
+    if (diverge) {
+      ASSERT_EQ(r.status.code, io::EstimateStatus::Code::kDiverged) << r.status.cause;
+      ASSERT_NE(r.status.cause.find("max_velocity_mps"), std::string::npos) << r.status.cause;
+      ASSERT_GT(r.counts.measurement_sets, 5u);
+    } else {
+      ASSERT_TRUE(r.status.ok()) << r.status.cause;
+      ASSERT_GT(r.counts.measurement_sets, 60u);
+    }
     counts.push_back(r.counts);
   }
   for (std::size_t k = 1; k < outs.size(); ++k) {
@@ -131,11 +143,12 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCountAndSe
     for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
       EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[k] + "/" + file)) << file << ", " << config;
     // timing.txt: the same rows, events and features (the processing time is the machine's).
-    if (configs[k].segment_s == configs[0].segment_s) {
-      EXPECT_TRUE(test::timingWithoutClock(outs[0] + "/timing.txt") == test::timingWithoutClock(outs[k] + "/timing.txt"))
-          << config;
-    }
+    EXPECT_TRUE(test::timingWithoutClock(outs[0] + "/timing.txt") == test::timingWithoutClock(outs[k] + "/timing.txt"))
+        << config;
     EXPECT_EQ(counts[0].events, counts[k].events) << config;
+    EXPECT_EQ(counts[0].events_kept, counts[k].events_kept) << config;
+    EXPECT_EQ(counts[0].frames, counts[k].frames) << config;
+    EXPECT_EQ(counts[0].imu_samples, counts[k].imu_samples) << config;
     EXPECT_EQ(counts[0].track_points, counts[k].track_points) << config;
     EXPECT_EQ(counts[0].measurement_sets, counts[k].measurement_sets) << config;
     EXPECT_EQ(counts[0].poses, counts[k].poses) << config;
@@ -144,18 +157,46 @@ TEST_F(PipelineSimulated, EkltVioEstimatesAreByteIdenticalForAnyThreadCountAndSe
   EXPECT_TRUE(test::anyFeatures(test::timingWithoutClock(outs[0] + "/timing.txt")));
 }
 
+TEST_F(PipelineSimulated, EkltVioOutputsAreByteIdenticalForAnyThreadCountAndSegment) {
+  expectSameOutputsForAnyThreadCountAndSegment("eklt", false);
+}
+
+TEST_F(PipelineSimulated, EkltVioStopsAtTheSameItemForAnyThreadCountAndSegment) {
+  expectSameOutputsForAnyThreadCountAndSegment("eklt_diverging", true);
+}
+
+// A 50 ms refractory filter and random halving before the tracker thin the
+// chunks inside a segment (some may hold no event): still the same files.
+TEST_F(PipelineSimulated, EkltVioWithPrefiltersIsTheSameWithSegments) {
+  std::vector<std::string> outs;
+  for (const double segment_s : {0.0, 0.01}) {
+    PipelineOptions o = fromGroundTruth("eklt-vio");
+    o.frontend.threads = 2;
+    o.frontend.segment_s = segment_s;
+    o.frontend.prefilter.refractory_period_s = 0.05;
+    o.frontend.prefilter.random_keep_one_in = 2;
+    outs.push_back(file("eklt_prefiltered_seg" + std::to_string(segment_s)));
+    const PipelineResult r = runPipeline(sequence(), o, outs.back());
+    ASSERT_GT(r.counts.track_points, 500u) << r.status.cause;
+    ASSERT_LT(r.counts.events_kept, r.counts.events / 2);
+  }
+  for (const char* file : {"trajectory.txt", "trajectory_covariance.txt", "imu_state.txt", "health.txt", "status.yaml"})
+    EXPECT_TRUE(io::readFile(outs[0] + "/" + file) == io::readFile(outs[1] + "/" + file)) << file;
+  EXPECT_TRUE(test::timingWithoutClock(outs[0] + "/timing.txt") == test::timingWithoutClock(outs[1] + "/timing.txt"));
+}
+
 // HASTE-VIO alike: 1 thread against 2 tracker threads and the backend
 // thread. (Its accuracy on these 2 s is not the point: with the defaults of
 // 5b9aa9a the self-diagnosis calls the run degraded; the status must be the
 // same bytes too.)
 TEST_F(PipelineSimulated, HasteVioEstimatesAreByteIdenticalForAnyThreadCount) {
   std::vector<std::string> outs;
-  for (int threads : {1, 2, 0}) {  // 0: one thread, each event chunk alone (no segments)
+  for (int run : {1, 2, 3}) {  // 1 thread; 2 threads, segments, backend thread; 2 threads without segments
     PipelineOptions o = fromGroundTruth("haste-vio");
-    o.frontend.threads = std::max(threads, 1);
-    o.backend_thread = threads > 1;
-    if (threads == 0) o.frontend.segment_s = 0.0;
-    outs.push_back(dir_->file("haste_threads_" + std::to_string(threads)));
+    o.frontend.threads = run == 1 ? 1 : 2;
+    o.backend_thread = run == 2;
+    if (run == 3) o.frontend.segment_s = 0.0;
+    outs.push_back(dir_->file("haste_run_" + std::to_string(run)));
     const PipelineResult r = runPipeline(sequence(), o, outs.back());
     ASSERT_GT(r.counts.measurement_sets, 30u) << r.status.cause;
     ASSERT_GT(r.counts.track_points, 1000u);

@@ -1,5 +1,6 @@
 #include "evio/estimator/frontend/chunk_points.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "evio/core/error.h"
@@ -36,6 +37,10 @@ void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackP
 void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, const std::vector<std::size_t>& chunk_ends,
                       TrackPoints& out, std::vector<std::size_t>& point_ends) {
   require(parts.size() <= 256, "mergeChunkPoints: at most 256 parts");
+  require(std::is_sorted(chunk_ends.begin(), chunk_ends.end()), "mergeChunkPoints: chunk ends must not decrease");
+  for (const std::vector<ChunkPoint>* p : parts)
+    require(p->empty() || (!chunk_ends.empty() && p->back().event < chunk_ends.back()),
+            "mergeChunkPoints: a point after the last chunk");
   std::size_t chunk = 0;
   // Closes the chunks that end at or before `event` (all of them for SIZE_MAX).
   const auto closeChunksBefore = [&](std::size_t event) {

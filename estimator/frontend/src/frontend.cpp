@@ -77,9 +77,7 @@ void Frontend::addEvents(const EventArray& events) {
   }
 }
 
-bool Frontend::tracksEventChunks() const {
-  return !reconstructor_ && !(options_.tracker == "eklt" && options_.eklt.imu_prediction);
-}
+bool Frontend::tracksEventChunks() const { return !reconstructor_ && !tracker_->usesImu(); }
 
 void Frontend::addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
                               std::vector<std::size_t>& point_ends) {

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -105,9 +106,18 @@ class PipelineRun {
   void setupReader(const std::vector<io::ImageStamp>& images);
   void setupStages();
   void loop();
-  void runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs);
-  /// At the end of the data: what the frontend still holds (a segment) goes through the synchroniser.
-  void finishFrontStages(std::vector<BackendInput>& backend_inputs);
+  /// The item through the reading side: `tracks`, or pre-filter, frontend
+  /// and synchroniser; then its backend work goes to the backend side.
+  void runFrontStages(SequenceItem& item, std::optional<SlotRingThread<BackendWork>>& handoff);
+  /// At the end of the data: what the frontend still holds (a segment) goes
+  /// through the synchroniser to the backend side.
+  void finishFrontStages(std::optional<SlotRingThread<BackendWork>>& handoff);
+  /// The frontend's outputs (tracked_) through the synchroniser, and to the
+  /// backend side one work per input, each with the snapshot taken when its
+  /// input was read: inputs held in a segment reach the backend side exactly
+  /// as they would have one by one.
+  void releaseTracked(std::optional<SlotRingThread<BackendWork>>& handoff);
+  void handOn(BackendWork& work, std::optional<SlotRingThread<BackendWork>>& handoff);
   void takeSnapshot(ItemSnapshot& snapshot) const;
   void consume(BackendWork& work);
   void afterItem(const ItemSnapshot& snapshot);
@@ -149,6 +159,8 @@ class PipelineRun {
   // Each stage's outputs, reused from item to item.
   std::vector<SequenceItem> filtered_;
   std::vector<FrontendOutput> tracked_;
+  std::vector<std::vector<BackendInput>> synced_;  // the synchroniser's outputs per entry of tracked_
+  std::deque<ItemSnapshot> snapshots_;  // of the inputs whose frontend outputs are still to come (a segment)
   BackendWork inline_work_;  // without a backend thread
   std::vector<Estimate> estimates_;
   std::vector<Estimate> checked_;
@@ -288,40 +300,83 @@ void PipelineRun::setupStages() {
   health_ = std::make_unique<HealthMonitor>(options_.health);
 }
 
-void PipelineRun::runFrontStages(SequenceItem& item, std::vector<BackendInput>& backend_inputs) {
+void PipelineRun::runFrontStages(SequenceItem& item, std::optional<SlotRingThread<BackendWork>>& handoff) {
   PipelineStageCpu& cpu = result_.cpu;
   StageCpuSplit& split = reading_cpu_;
-  split.begin();
-  StageTimer timer(&result_.times.frontend_s);
   if (tracks_) {
-    tracks_->process(item, backend_inputs);
+    BackendWork& work = handoff ? handoff->slot() : inline_work_;
+    work.inputs.clear();
+    split.begin();
+    {
+      StageTimer timer(&result_.times.frontend_s);
+      tracks_->process(item, work.inputs);
+    }
     split.lap(&cpu.sync_s);
+    takeSnapshot(work.snapshot);
+    handOn(work, handoff);
     return;
   }
-  filtered_.clear();
-  tracked_.clear();
-  prefilter_->process(item, filtered_);
-  split.lap(&cpu.prefilter_s);
-  // The tracker's wait for its worker threads uses no CPU of this thread.
-  const double waited0 = frontend_->trackerParallelCpu().wait_s;
-  for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
-  split.lap(&cpu.tracking_s, frontend_->trackerParallelCpu().wait_s - waited0);
-  for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs);
-  split.lap(&cpu.sync_s);
-  if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
+  split.begin();
+  {
+    StageTimer timer(&result_.times.frontend_s);
+    filtered_.clear();
+    tracked_.clear();
+    prefilter_->process(item, filtered_);
+    split.lap(&cpu.prefilter_s);
+    // The tracker's wait for its worker threads uses no CPU of this thread.
+    const double waited0 = frontend_->trackerParallelCpu().wait_s;
+    for (SequenceItem& f : filtered_) frontend_->process(f, tracked_);
+    split.lap(&cpu.tracking_s, frontend_->trackerParallelCpu().wait_s - waited0);
+    if (!filtered_.empty()) std::swap(item, filtered_.front());  // the reader keeps its buffers
+  }
+  takeSnapshot(snapshots_.emplace_back());
+  releaseTracked(handoff);
 }
 
-void PipelineRun::finishFrontStages(std::vector<BackendInput>& backend_inputs) {
+void PipelineRun::finishFrontStages(std::optional<SlotRingThread<BackendWork>>& handoff) {
+  if (!frontend_ || !frontend_->holding()) return;
   PipelineStageCpu& cpu = result_.cpu;
   StageCpuSplit& split = reading_cpu_;
   split.begin();
-  StageTimer timer(&result_.times.frontend_s);
-  tracked_.clear();
-  const double waited0 = frontend_->trackerParallelCpu().wait_s;
-  frontend_->finish(tracked_);
-  split.lap(&cpu.tracking_s, frontend_->trackerParallelCpu().wait_s - waited0);
-  for (FrontendOutput& t : tracked_) sync_->process(t, backend_inputs);
+  {
+    StageTimer timer(&result_.times.frontend_s);
+    tracked_.clear();
+    const double waited0 = frontend_->trackerParallelCpu().wait_s;
+    frontend_->finish(tracked_);
+    split.lap(&cpu.tracking_s, frontend_->trackerParallelCpu().wait_s - waited0);
+  }
+  releaseTracked(handoff);
+}
+
+void PipelineRun::releaseTracked(std::optional<SlotRingThread<BackendWork>>& handoff) {
+  PipelineStageCpu& cpu = result_.cpu;
+  StageCpuSplit& split = reading_cpu_;
+  // Every input gives the frontend stage exactly one output, in input order.
+  require(tracked_.size() <= snapshots_.size(), "pipeline: the frontend released more outputs than it took inputs");
+  if (synced_.size() < tracked_.size()) synced_.resize(tracked_.size());
+  {
+    StageTimer timer(&result_.times.frontend_s);
+    for (std::size_t k = 0; k < tracked_.size(); ++k) {
+      synced_[k].clear();
+      sync_->process(tracked_[k], synced_[k]);
+      snapshots_[k].counts.track_points = sync_->numTrackPoints();
+    }
+  }
   split.lap(&cpu.sync_s);
+  for (std::size_t k = 0; k < tracked_.size(); ++k) {
+    BackendWork& work = handoff ? handoff->slot() : inline_work_;
+    std::swap(work.inputs, synced_[k]);
+    work.snapshot = snapshots_.front();
+    snapshots_.pop_front();
+    handOn(work, handoff);
+  }
+}
+
+void PipelineRun::handOn(BackendWork& work, std::optional<SlotRingThread<BackendWork>>& handoff) {
+  if (handoff)
+    handoff->push();
+  else
+    consume(work);
 }
 
 void PipelineRun::takeSnapshot(ItemSnapshot& s) const {
@@ -443,25 +498,9 @@ void PipelineRun::loop() {
       have_imu_ = true;
       last_imu_cam_ = item.t_ns;
     }
-    BackendWork& work = handoff ? handoff->slot() : inline_work_;
-    work.inputs.clear();
-    runFrontStages(item, work.inputs);
-    takeSnapshot(work.snapshot);
-    if (handoff)
-      handoff->push();
-    else
-      consume(work);
+    runFrontStages(item, handoff);
   }
-  if (frontend_ && frontend_->holding() && !stopped_.load() && !(handoff && handoff->failed())) {
-    BackendWork& work = handoff ? handoff->slot() : inline_work_;
-    work.inputs.clear();
-    finishFrontStages(work.inputs);
-    takeSnapshot(work.snapshot);
-    if (handoff)
-      handoff->push();
-    else
-      consume(work);
-  }
+  if (!stopped_.load() && !(handoff && handoff->failed())) finishFrontStages(handoff);
   if (handoff) handoff->finish();
   closeBackend();
   reading_cpu_.flush();

@@ -27,7 +27,9 @@ void PrefilterStage::process(SequenceItem& in, std::vector<SequenceItem>& out) {
 
 FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera)
     : frontend_(options, camera.camera, camera.T_B_C) {
-  if (options.segment_s > 0.0 && frontend_.tracksEventChunks()) segment_ns_ = secondsToNs(options.segment_s);
+  // Segments serve the threads; on one they would only add latency.
+  if (options.segment_s > 0.0 && options.threads > 1 && frontend_.tracksEventChunks())
+    segment_ns_ = secondsToNs(options.segment_s);
 }
 
 const EkltTiming* FrontendStage::ekltTiming() const {

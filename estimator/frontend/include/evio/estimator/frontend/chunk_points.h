@@ -25,8 +25,9 @@ struct ChunkPoint {
 void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackPoints& out);
 
 /// The same for events that arrived as consecutive chunks [0, e0), [e0, e1), …
-/// (`chunk_ends`): also appends to `point_ends`, for every chunk, out.size()
-/// after its points (a point belongs to the chunk of the event that produced it).
+/// (`chunk_ends`, non-decreasing; every point's event below its last entry):
+/// also appends to `point_ends`, for every chunk, out.size() after its points
+/// (a point belongs to the chunk of the event that produced it).
 void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, const std::vector<std::size_t>& chunk_ends,
                       TrackPoints& out, std::vector<std::size_t>& point_ends);
 

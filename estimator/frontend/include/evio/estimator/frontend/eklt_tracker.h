@@ -77,6 +77,7 @@ class EkltTracker final : public FeatureTracker {
   void addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
                       std::vector<std::size_t>& point_ends) override;
   void addImu(const ImuSample& sample) override;
+  bool usesImu() const override { return predictor_ != nullptr; }
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override;
   std::string_view name() const override { return "eklt"; }

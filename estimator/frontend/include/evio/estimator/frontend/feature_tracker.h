@@ -50,6 +50,11 @@ class FeatureTracker {
     }
   }
 
+  /// True when addImu changes what the tracker does with later events (a
+  /// gyro prediction): then the IMU's place among the events matters, and
+  /// chunks separated by IMU samples cannot be tracked as one segment.
+  virtual bool usesImu() const { return false; }
+
   /// One gyro/accelerometer sample (used for feature prediction when enabled).
   virtual void addImu(const ImuSample& sample) = 0;
 

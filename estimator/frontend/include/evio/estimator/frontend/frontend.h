@@ -29,13 +29,16 @@ struct FrontendOptions {
   /// Threads tracking features in parallel (EKLT and HASTE; KLT uses one).
   /// The output is byte-identical for any value (eklt_tracker.h).
   int threads = 1;
-  /// The pipeline tracks the event chunks of up to this span of data (s) in
-  /// one call (FeatureTracker::addEventChunks), holding the inputs between
-  /// them, so that the threads share the work of many chunks instead of one
-  /// IMU period's; the outputs keep their order, so the estimates do not
-  /// depend on it, only the latency grows by up to this span. Applies where
-  /// nothing between the chunks reaches the tracker (EKLT or HASTE on sensor
-  /// frames, no gyro prediction); 0: every chunk alone.
+  /// With threads > 1, `evio estimate` tracks the event chunks of up to this
+  /// span of data (s, counted from the first held chunk's end) in one call
+  /// (FeatureTracker::addEventChunks), holding the inputs between them, so
+  /// that the threads share the work of many chunks instead of one IMU
+  /// period's. The held inputs reach the synchroniser and the backend side
+  /// in their order, one by one, so every output file is the same; only the
+  /// estimates' latency grows, by up to this span plus one chunk. Applies
+  /// where nothing between the chunks changes the tracker (EKLT or HASTE on
+  /// sensor frames, no gyro prediction); 0: every chunk alone. (`evio track`
+  /// hands the tracker whole files' chunks itself.)
   double segment_s = 0.05;
   EventPrefilterOptions prefilter;  ///< for the pre-filter that runs before the frontend
   EkltOptions eklt;
@@ -87,8 +90,8 @@ class Frontend {
   /// Appends the track points since the last call (the lag probe sees them too).
   void drainTrackPoints(TrackPoints& out);
   /// True when the events of several chunks may be tracked in one call:
-  /// nothing but events reaches the tracker between them (no reconstruction,
-  /// no gyro prediction).
+  /// nothing but events changes the tracker between them (no reconstruction;
+  /// a tracker that does not use the IMU, FeatureTracker::usesImu).
   bool tracksEventChunks() const;
   /// The chunks [0, e0), [e0, e1), … of `events` (FeatureTracker::addEventChunks):
   /// the same as addEvents and drainTrackPoints chunk by chunk.

@@ -63,12 +63,14 @@ class PrefilterStage : public Stage<SequenceItem, SequenceItem> {
 /// The tracker (EKLT or KLT, with the optional reconstruction): events and
 /// frames in, track points out; IMU samples feed its gyro prediction.
 ///
-/// Segments (FrontendOptions::segment_s): where the tracker takes nothing
-/// but events between chunks, event and IMU inputs are held until their
-/// span reaches segment_s (or a frame or range reading comes, or the data
-/// end: finish), the held chunks are tracked in one call, and the held
-/// inputs leave in their order, each event input with its own chunk's
-/// points: the next stages see exactly what they would see input by input.
+/// Segments (FrontendOptions::segment_s, with threads > 1): where only
+/// events change the tracker between chunks (EKLT or HASTE), event inputs,
+/// and the IMU inputs that come after a held one, are held until their span
+/// reaches segment_s or they hold kMaxSegmentEvents events (or a frame or
+/// range reading comes, or the data end: finish); the held chunks are
+/// tracked in one call, and the held inputs leave in their order, one output
+/// per input, each event input with its own chunk's points: the next stages
+/// see exactly what they would see input by input.
 class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
  public:
   FrontendStage(const FrontendOptions& options, const CameraSensor& camera);

@@ -7,10 +7,15 @@
 
 namespace evio::estimator {
 
-void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackPoints& out) {
+namespace {
+
+/// Calls visit(point) for the parts' points in (event, slot) order (each
+/// part is in that order already), then clears the parts.
+template <class Visit>
+void visitInOrderAndClear(const std::vector<std::vector<ChunkPoint>*>& parts, Visit visit) {
   require(parts.size() <= 256, "mergeChunkPoints: at most 256 parts");
   if (parts.size() == 1) {
-    for (const ChunkPoint& c : *parts.front()) out.push_back(c.point);
+    for (const ChunkPoint& c : *parts.front()) visit(c);
     parts.front()->clear();
     return;
   }
@@ -28,15 +33,20 @@ void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackP
       }
     }
     if (!best) break;
-    out.push_back(best->point);
+    visit(*best);
     ++heads[best_part];
   }
   for (std::vector<ChunkPoint>* p : parts) p->clear();
 }
 
+}  // namespace
+
+void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, TrackPoints& out) {
+  visitInOrderAndClear(parts, [&out](const ChunkPoint& c) { out.push_back(c.point); });
+}
+
 void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, const std::vector<std::size_t>& chunk_ends,
                       TrackPoints& out, std::vector<std::size_t>& point_ends) {
-  require(parts.size() <= 256, "mergeChunkPoints: at most 256 parts");
   require(std::is_sorted(chunk_ends.begin(), chunk_ends.end()), "mergeChunkPoints: chunk ends must not decrease");
   for (const std::vector<ChunkPoint>* p : parts)
     require(p->empty() || (!chunk_ends.empty() && p->back().event < chunk_ends.back()),
@@ -49,26 +59,11 @@ void mergeChunkPoints(const std::vector<std::vector<ChunkPoint>*>& parts, const 
       ++chunk;
     }
   };
-  std::size_t heads[256] = {};
-  while (true) {
-    const ChunkPoint* best = nullptr;
-    std::size_t best_part = 0;
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      const std::vector<ChunkPoint>& pts = *parts[k];
-      if (heads[k] == pts.size()) continue;
-      const ChunkPoint& c = pts[heads[k]];
-      if (!best || c.event < best->event || (c.event == best->event && c.slot < best->slot)) {
-        best = &c;
-        best_part = k;
-      }
-    }
-    if (!best) break;
-    closeChunksBefore(best->event);
-    out.push_back(best->point);
-    ++heads[best_part];
-  }
+  visitInOrderAndClear(parts, [&](const ChunkPoint& c) {
+    closeChunksBefore(c.event);
+    out.push_back(c.point);
+  });
   closeChunksBefore(std::numeric_limits<std::size_t>::max());
-  for (std::vector<ChunkPoint>* p : parts) p->clear();
 }
 
 }  // namespace evio::estimator

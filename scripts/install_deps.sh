@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libceres-dev libopencv-dev libembree-dev libtbb-dev
-  libopenexr-dev libyaml-cpp-dev libhdf5-dev libcli11-dev libgdal-dev
+  libopenexr-dev libyaml-cpp-dev libhdf5-dev libcli11-dev libgdal-dev libpng-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3 python3-matplotlib python3-numpy python3-yaml python3-pil
   python3-dev pybind11-dev

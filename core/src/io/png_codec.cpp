@@ -118,15 +118,24 @@ bool writeImage(png_structp png, png_infop info, const Layout& layout, int colou
   return true;
 }
 
-class ReadStruct {
+/// libpng's read (kWrite false) or write struct with its info struct,
+/// destroyed together.
+template <bool kWrite>
+class PngStruct {
  public:
-  explicit ReadStruct(PngIo* io) {
-    png_ = png_create_read_struct(PNG_LIBPNG_VER_STRING, io, onError, onWarning);
+  explicit PngStruct(PngIo* io) {
+    png_ = kWrite ? png_create_write_struct(PNG_LIBPNG_VER_STRING, io, onError, onWarning)
+                  : png_create_read_struct(PNG_LIBPNG_VER_STRING, io, onError, onWarning);
     if (png_) info_ = png_create_info_struct(png_);
   }
-  ~ReadStruct() { png_destroy_read_struct(&png_, info_ ? &info_ : nullptr, nullptr); }
-  ReadStruct(const ReadStruct&) = delete;
-  ReadStruct& operator=(const ReadStruct&) = delete;
+  ~PngStruct() {
+    if constexpr (kWrite)
+      png_destroy_write_struct(&png_, info_ ? &info_ : nullptr);
+    else
+      png_destroy_read_struct(&png_, info_ ? &info_ : nullptr, nullptr);
+  }
+  PngStruct(const PngStruct&) = delete;
+  PngStruct& operator=(const PngStruct&) = delete;
   bool ok() const { return png_ && info_; }
   png_structp png() const { return png_; }
   png_infop info() const { return info_; }
@@ -135,24 +144,8 @@ class ReadStruct {
   png_structp png_ = nullptr;
   png_infop info_ = nullptr;
 };
-
-class WriteStruct {
- public:
-  explicit WriteStruct(PngIo* io) {
-    png_ = png_create_write_struct(PNG_LIBPNG_VER_STRING, io, onError, onWarning);
-    if (png_) info_ = png_create_info_struct(png_);
-  }
-  ~WriteStruct() { png_destroy_write_struct(&png_, info_ ? &info_ : nullptr); }
-  WriteStruct(const WriteStruct&) = delete;
-  WriteStruct& operator=(const WriteStruct&) = delete;
-  bool ok() const { return png_ && info_; }
-  png_structp png() const { return png_; }
-  png_infop info() const { return info_; }
-
- private:
-  png_structp png_ = nullptr;
-  png_infop info_ = nullptr;
-};
+using ReadStruct = PngStruct<false>;
+using WriteStruct = PngStruct<true>;
 
 std::vector<png_bytep> rowPointers(const cv::Mat& image) {
   std::vector<png_bytep> rows(static_cast<std::size_t>(image.rows));

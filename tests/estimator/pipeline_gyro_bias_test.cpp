@@ -110,6 +110,28 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   EXPECT_TRUE(r_off.gyro_bias->from_tracks);
 }
 
+TEST(PipelineGyroBias, TracksOnceStartsFromTheWindowAndSkipsItsSets) {
+  // init.gyro_bias_window_tracks_once: the same window estimate, and the
+  // filter skips the window's second of measurement sets (it holds only the
+  // window's IMU), then runs on the later ones.
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  so.gyro_bias_radps = kTrueBias;
+  writeTinySequence(seq, so);
+  const PipelineResult twice = runPipeline(seq, windowOptions(1.0), dir.file("twice"));
+  PipelineOptions o = windowOptions(1.0);
+  o.init.gyro_bias_window_tracks_once = true;
+  const PipelineResult once = runPipeline(seq, o, dir.file("once"));
+  ASSERT_TRUE(twice.status.ok()) << twice.status.cause;
+  ASSERT_TRUE(once.status.ok()) << once.status.cause;
+  ASSERT_TRUE(once.gyro_bias.has_value() && twice.gyro_bias.has_value());
+  EXPECT_EQ(once.gyro_bias->b_g, twice.gyro_bias->b_g);
+  EXPECT_GE(twice.counts.measurement_sets, once.counts.measurement_sets + 10);
+  EXPECT_GT(once.counts.measurement_sets, 10u);
+}
+
 TEST(PipelineGyroBias, AWindowLongerThanTheDataClosesAtTheEnd) {
   // A window of 10 s over 2 s of data: closed at the end of the data with
   // what it holds, the filter then runs over all of it.

@@ -197,12 +197,25 @@ void BackendStage::closeWindow(std::vector<Estimate>& out) {
     for (BackendInput& in : window_->takeInputsFrom(rest->first.t_ns)) feed(in, out);
     return;
   }
+  ImuState x0 = window_->initialState();
+  x0.b_g = gyro_bias_->b_g;
+  if (window_->tracksOnce() && gyro_bias_->from_tracks) {
+    // The window's tracks are used once, by the window: the filter starts
+    // with the estimate and its covariance, and takes only the window's IMU
+    // and range readings.
+    Eigen::Matrix<double, 15, 15> P = P0;
+    P.block<3, 15>(kIdxBg, 0).setZero();
+    P.block<15, 3>(0, kIdxBg).setZero();
+    P.block<3, 3>(kIdxBg, kIdxBg) = gyro_bias_->covariance;
+    backend_.initialize(x0, P);
+    for (BackendInput& in : window_->takeInputs())
+      if (!std::holds_alternative<MeasurementSet>(in)) feed(in, out);
+    return;
+  }
   // The tracks' estimate moves the bias's mean, the point the filter
   // linearises at; its covariance stays the prior's, since the filter is
   // about to take the window's tracks again (told both, it would count them
   // twice).
-  ImuState x0 = window_->initialState();
-  x0.b_g = gyro_bias_->b_g;
   backend_.initialize(x0, P0);
   for (BackendInput& in : window_->takeInputs()) feed(in, out);
 }

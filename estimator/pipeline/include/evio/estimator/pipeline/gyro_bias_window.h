@@ -64,6 +64,11 @@ class GyroBiasWindow {
   /// The buffered inputs at or after t_imu_ns (IMU clock), in their order, moved out.
   std::vector<BackendInput> takeInputsFrom(TimeNs t_imu_ns);
   const ImuState& initialState() const { return *x0_; }
+  /// init.gyro_bias_window_tracks_once: the filter takes the tracks' estimate
+  /// with its covariance and, of the window's inputs, only the IMU and range
+  /// readings (the window's tracks are used once, by the window).
+  void setTracksOnce(bool on) { tracks_once_ = on; }
+  bool tracksOnce() const { return tracks_once_; }
   /// The buffered inputs in their order, moved out.
   std::vector<BackendInput> takeInputs() { return std::move(inputs_); }
 
@@ -77,6 +82,7 @@ class GyroBiasWindow {
   WindowRestTest rest_test_;
   GyroBiasFromTracksOptions solver_;
   std::optional<std::pair<ImuState, Eigen::Matrix<double, 15, 15>>> rest_start_;
+  bool tracks_once_ = false;
   std::optional<ImuState> x0_;
   bool complete_ = false;
   TimeNs next_keyframe_ns_ = 0;

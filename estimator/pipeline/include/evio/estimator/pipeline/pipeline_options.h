@@ -71,6 +71,10 @@ struct InitOptions {
   /// at rest its mean readings give both biases (and the tilt) as one update
   /// of the initial state, with their covariance, instead of the tracks.
   bool gyro_bias_window_rest = true;
+  /// Use the window's tracks once: the filter takes the tracks' bias with
+  /// its covariance and skips the window's measurement sets (else it keeps
+  /// the prior's σ and takes the window's tracks again).
+  bool gyro_bias_window_tracks_once = false;
 
   template <class V>
   void fields(V& v) {
@@ -81,6 +85,8 @@ struct InitOptions {
     v("gyro_bias_window_s", gyro_bias_window_s, "groundtruth: gyroscope bias from this long of tracks first, s (0: off)");
     v("gyro_bias_keyframe_s", gyro_bias_keyframe_s, "keyframe spacing in the gyroscope-bias window, s");
     v("gyro_bias_window_rest", gyro_bias_window_rest, "a window whose IMU is at rest gives both biases from its mean");
+    v("gyro_bias_window_tracks_once", gyro_bias_window_tracks_once,
+      "the filter takes the window's bias with its covariance and skips the window's tracks");
   }
   void validate() const;
 };

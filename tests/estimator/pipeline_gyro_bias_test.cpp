@@ -32,6 +32,18 @@ PipelineOptions windowOptions(double window_s, double noise_px = 0.5) {
   return o;
 }
 
+/// 3 s of the tiny rig with the simulated gyroscope bias kTrueBias, written
+/// to `dir`/seq; returns the folder.
+std::string writeBiasedSequence(const test::TempDir& dir, const std::string& trajectory_preset = "six_dof.yaml") {
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 3.0;
+  so.gyro_bias_radps = kTrueBias;
+  so.trajectory_preset = trajectory_preset;
+  writeTinySequence(seq, so);
+  return seq;
+}
+
 TEST(PipelineGyroBias, TheWindowFindsTheSimulatedBiasAndTheFilterStartsAtTheInitialTime) {
   // Exact tracks with 0.5 px of noise at 20 Hz of a cloud in front of the
   // camera: the estimate is inside its 99.9 % ellipsoid (χ²₃ < 16.3) and
@@ -40,11 +52,7 @@ TEST(PipelineGyroBias, TheWindowFindsTheSimulatedBiasAndTheFilterStartsAtTheInit
   // ground-truth time with the window replayed: the first pose is at the
   // initial time.
   test::TempDir dir;
-  const std::string seq = dir.file("seq"), out = dir.file("out");
-  test::TinySequenceOptions so;
-  so.duration_s = 3.0;
-  so.gyro_bias_radps = kTrueBias;
-  writeTinySequence(seq, so);
+  const std::string seq = writeBiasedSequence(dir), out = dir.file("out");
   const PipelineResult r = runPipeline(seq, windowOptions(1.0), out);
   ASSERT_TRUE(r.status.ok()) << r.status.cause;
   ASSERT_TRUE(r.gyro_bias.has_value());
@@ -73,12 +81,7 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   // rotation error too: the tracks find the bias, and the filter keeps the
   // prior's σ, since it takes the tracks again).
   test::TempDir dir;
-  const std::string seq = dir.file("seq");
-  test::TinySequenceOptions so;
-  so.duration_s = 3.0;
-  so.gyro_bias_radps = kTrueBias;
-  so.trajectory_preset = "flight.yaml";
-  writeTinySequence(seq, so);
+  const std::string seq = writeBiasedSequence(dir, "flight.yaml");
   const PipelineResult r = runPipeline(seq, windowOptions(1.0), dir.file("out"));
   ASSERT_TRUE(r.status.ok()) << r.status.cause;
   ASSERT_TRUE(r.gyro_bias.has_value());
@@ -115,11 +118,7 @@ TEST(PipelineGyroBias, TracksOnceStartsFromTheWindowAndSkipsItsSets) {
   // filter skips the window's second of measurement sets (it holds only the
   // window's IMU), then runs on the later ones.
   test::TempDir dir;
-  const std::string seq = dir.file("seq");
-  test::TinySequenceOptions so;
-  so.duration_s = 3.0;
-  so.gyro_bias_radps = kTrueBias;
-  writeTinySequence(seq, so);
+  const std::string seq = writeBiasedSequence(dir);
   const PipelineResult twice = runPipeline(seq, windowOptions(1.0), dir.file("twice"));
   PipelineOptions o = windowOptions(1.0);
   o.init.gyro_bias_window_tracks_once = true;

@@ -131,6 +131,31 @@ TEST(PipelineGyroBias, TracksOnceStartsFromTheWindowAndSkipsItsSets) {
   EXPECT_GT(once.counts.measurement_sets, 10u);
 }
 
+TEST(PipelineGyroBias, TheReplayStartsWithThePriorSigmaOrTheWindowsAsAsked) {
+  // init.gyro_bias_window_sigma: the replay's filter starts with the prior's
+  // bias block (6 °/s on each axis, uncorrelated) or with the window's
+  // estimate's covariance, exactly; the summary states which σ it was told.
+  test::TempDir dir;
+  const std::string seq = writeBiasedSequence(dir);
+  const PipelineResult prior = runPipeline(seq, windowOptions(1.0), dir.file("prior"));
+  PipelineOptions o = windowOptions(1.0);
+  o.init.gyro_bias_window_sigma = "window";
+  const PipelineResult window = runPipeline(seq, o, dir.file("window"));
+  ASSERT_TRUE(prior.status.ok()) << prior.status.cause;
+  ASSERT_TRUE(window.status.ok()) << window.status.cause;
+  ASSERT_TRUE(prior.gyro_bias.has_value() && window.gyro_bias.has_value());
+  ASSERT_TRUE(window.gyro_bias->from_tracks);
+  const double prior_sigma = 6.0 * (M_PI / 180.0), prior_var = prior_sigma * prior_sigma;
+  EXPECT_EQ(prior.gyro_bias->filter_start_covariance, Mat3(Vec3::Constant(prior_var).asDiagonal()));
+  EXPECT_EQ(window.gyro_bias->filter_start_covariance, window.gyro_bias->covariance);
+  // The window's σ is far below the prior's here (0.5 px tracks).
+  EXPECT_LT(window.gyro_bias->covariance.diagonal().maxCoeff(), 0.1 * prior_var);
+  EXPECT_NE(io::readFile(dir.file("window/summary.yaml")).find("filter_start_sigma_degps:"), std::string::npos);
+  // The same window estimate either way; the filter's run differs.
+  EXPECT_EQ(window.gyro_bias->b_g, prior.gyro_bias->b_g);
+  EXPECT_NE(io::readFile(dir.file("window/trajectory.txt")), io::readFile(dir.file("prior/trajectory.txt")));
+}
+
 TEST(PipelineGyroBias, AWindowLongerThanTheDataClosesAtTheEnd) {
   // A window of 10 s over 2 s of data: closed at the end of the data with
   // what it holds, the filter then runs over all of it.
@@ -189,6 +214,9 @@ TEST(PipelineGyroBias, TheWindowNeedsTheGroundTruthStartAndTwoPairs) {
   o = windowOptions(1.0);
   o.init.gyro_bias_keyframe_s = 0.5;
   EXPECT_NE(validationError(o.init).find("gyro_bias_keyframe_s"), std::string::npos);
+  o = windowOptions(1.0);
+  o.init.gyro_bias_window_sigma = "posterior";
+  EXPECT_NE(validationError(o.init).find("gyro_bias_window_sigma"), std::string::npos);
 }
 
 }  // namespace

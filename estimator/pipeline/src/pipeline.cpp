@@ -296,6 +296,7 @@ void PipelineRun::setupStages() {
     gyro_bias_window.emplace(options_.init.gyro_bias_window_s, options_.init.gyro_bias_keyframe_s,
                              tracker_camera_->camera, tracker_camera_->T_B_C.rotation(), offset_ns_, rest);
     gyro_bias_window->setTracksOnce(options_.init.gyro_bias_window_tracks_once);
+    gyro_bias_window->setReplayWithWindowSigma(options_.init.gyro_bias_window_sigma == "window");
   }
   backend_stage_ = std::make_unique<BackendStage>(*backend_, std::move(initializer), std::move(gyro_bias_window));
   health_ = std::make_unique<HealthMonitor>(options_.health);

@@ -21,6 +21,8 @@ void InitOptions::validate() const {
   requirePositive("gyro_bias_keyframe_s", gyro_bias_keyframe_s);
   requireField(gyro_bias_window_s == 0.0 || gyro_bias_keyframe_s * 3.0 <= gyro_bias_window_s, "gyro_bias_keyframe_s",
                "at most a third of gyro_bias_window_s (the estimate needs two keyframe pairs)");
+  requireField(gyro_bias_window_sigma == "prior" || gyro_bias_window_sigma == "window", "gyro_bias_window_sigma",
+               "must be prior or window (got '" + gyro_bias_window_sigma + "')");
 }
 
 void CalibrationOptions::validate() const {

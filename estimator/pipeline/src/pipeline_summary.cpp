@@ -33,6 +33,7 @@ void emitGyroBias(YAML::Emitter& out, const GyroBiasEstimate& e) {
   if (e.at_rest) emitSeconds(out, "rest_s", e.rest_s);
   emitVector(out, "b_g_degps", kDeg * e.b_g);
   emitVector(out, "sigma_degps", kDeg * e.covariance.diagonal().cwiseSqrt());
+  emitVector(out, "filter_start_sigma_degps", kDeg * e.filter_start_covariance.diagonal().cwiseSqrt());
   if (e.at_rest) {
     emitVector(out, "b_a_mps2", e.rest_b_a);
     emitVector(out, "sigma_b_a_mps2", e.rest_b_a_covariance.diagonal().cwiseSqrt());

@@ -193,31 +193,43 @@ void BackendStage::closeWindow(std::vector<Estimate>& out) {
     // with the rest update's state and covariance, and takes the inputs from
     // then on (propagating through the readings the update averaged, it
     // would take their noise twice).
-    backend_.initialize(rest->first, rest->second);
+    startFilter(rest->first, rest->second);
     for (BackendInput& in : window_->takeInputsFrom(rest->first.t_ns)) feed(in, out);
     return;
   }
   ImuState x0 = window_->initialState();
   x0.b_g = gyro_bias_->b_g;
-  if (window_->tracksOnce() && gyro_bias_->from_tracks) {
-    // The window's tracks are used once, by the window: the filter starts
-    // with the estimate and its covariance, and takes only the window's IMU
-    // and range readings.
+  // P0 with the bias block replaced by the tracks' covariance (no
+  // correlation with the rest of the state, which the window did not see).
+  const auto with_window_sigma = [&] {
     Eigen::Matrix<double, 15, 15> P = P0;
     P.block<3, 15>(kIdxBg, 0).setZero();
     P.block<15, 3>(0, kIdxBg).setZero();
     P.block<3, 3>(kIdxBg, kIdxBg) = gyro_bias_->covariance;
-    backend_.initialize(x0, P);
+    return P;
+  };
+  if (window_->tracksOnce() && gyro_bias_->from_tracks) {
+    // The window's tracks are used once, by the window: the filter starts
+    // with the estimate and its covariance, and takes only the window's IMU
+    // and range readings.
+    startFilter(x0, with_window_sigma());
     for (BackendInput& in : window_->takeInputs())
       if (!std::holds_alternative<MeasurementSet>(in)) feed(in, out);
     return;
   }
   // The tracks' estimate moves the bias's mean, the point the filter
-  // linearises at; its covariance stays the prior's, since the filter is
-  // about to take the window's tracks again (told both, it would count them
-  // twice).
-  backend_.initialize(x0, P0);
+  // linearises at. Its covariance stays the prior's unless asked otherwise
+  // (init.gyro_bias_window_sigma): the filter is about to take the window's
+  // tracks again, and told both it counts them twice where it updates
+  // inside the window.
+  const bool window_sigma = window_->replayWithWindowSigma() && gyro_bias_->from_tracks;
+  startFilter(x0, window_sigma ? with_window_sigma() : P0);
   for (BackendInput& in : window_->takeInputs()) feed(in, out);
+}
+
+void BackendStage::startFilter(const ImuState& x0, const Eigen::Matrix<double, 15, 15>& P) {
+  gyro_bias_->filter_start_covariance = P.block<3, 3>(kIdxBg, kIdxBg);
+  backend_.initialize(x0, P);
 }
 
 void BackendStage::feed(BackendInput& in, std::vector<Estimate>& out) {

@@ -113,6 +113,10 @@ struct GyroBiasEstimate {
   /// tilt): its posterior mean, m/s², and covariance, (m/s²)².
   Vec3 rest_b_a = Vec3::Zero();
   Mat3 rest_b_a_covariance = Mat3::Zero();
+  /// The bias block of the covariance the filter started with, (rad/s)²
+  /// (set by the pipeline: the prior's, or this estimate's; see
+  /// init.gyro_bias_window_sigma).
+  Mat3 filter_start_covariance = Mat3::Zero();
 };
 
 /// The bundle adjustment's result (refineGyroBiasByBundleAdjustment).

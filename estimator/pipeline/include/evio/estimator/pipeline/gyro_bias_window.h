@@ -69,6 +69,10 @@ class GyroBiasWindow {
   /// readings (the window's tracks are used once, by the window).
   void setTracksOnce(bool on) { tracks_once_ = on; }
   bool tracksOnce() const { return tracks_once_; }
+  /// init.gyro_bias_window_sigma=window: the replay starts with the tracks'
+  /// covariance for the bias instead of the prior's.
+  void setReplayWithWindowSigma(bool on) { replay_with_window_sigma_ = on; }
+  bool replayWithWindowSigma() const { return replay_with_window_sigma_; }
   /// The buffered inputs in their order, moved out.
   std::vector<BackendInput> takeInputs() { return std::move(inputs_); }
 
@@ -83,6 +87,7 @@ class GyroBiasWindow {
   GyroBiasFromTracksOptions solver_;
   std::optional<std::pair<ImuState, Eigen::Matrix<double, 15, 15>>> rest_start_;
   bool tracks_once_ = false;
+  bool replay_with_window_sigma_ = false;
   std::optional<ImuState> x0_;
   bool complete_ = false;
   TimeNs next_keyframe_ns_ = 0;

@@ -75,6 +75,12 @@ struct InitOptions {
   /// its covariance and skips the window's measurement sets (else it keeps
   /// the prior's σ and takes the window's tracks again).
   bool gyro_bias_window_tracks_once = false;
+  /// The bias's σ the filter starts with when it takes the window's tracks
+  /// again: "prior" (the initial state's, as if the window had not been
+  /// estimated) or "window" (the window's estimate's covariance: the tracks
+  /// then inform the bias twice wherever the filter updates inside the
+  /// window).
+  std::string gyro_bias_window_sigma = "prior";
 
   template <class V>
   void fields(V& v) {
@@ -87,6 +93,8 @@ struct InitOptions {
     v("gyro_bias_window_rest", gyro_bias_window_rest, "a window whose IMU is at rest gives both biases from its mean");
     v("gyro_bias_window_tracks_once", gyro_bias_window_tracks_once,
       "the filter takes the window's bias with its covariance and skips the window's tracks");
+    v("gyro_bias_window_sigma", gyro_bias_window_sigma,
+      "the bias's starting sigma when the window's tracks are replayed: prior or window");
   }
   void validate() const;
 };

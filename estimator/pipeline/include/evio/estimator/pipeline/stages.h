@@ -154,6 +154,9 @@ class BackendStage : public Stage<BackendInput, Estimate> {
  private:
   void feed(BackendInput& in, std::vector<Estimate>& out);
   void closeWindow(std::vector<Estimate>& out);
+  /// Initialises the backend at the window's close and records the bias block
+  /// of P in the estimate (filter_start_covariance).
+  void startFilter(const ImuState& x0, const Eigen::Matrix<double, 15, 15>& P);
 
   Backend& backend_;
   std::optional<GroundTruthInitializer> initializer_;

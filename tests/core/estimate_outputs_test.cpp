@@ -5,19 +5,13 @@
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/status_yaml.h"
 #include "evio/core/io/timing_txt.h"
+#include "error_of.h"
 #include "temp_dir.h"
 
 namespace evio {
 namespace {
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::errorOf;
 
 TEST(TimingText, RoundTripsAndStartsWithItsHeader) {
   std::vector<io::TimingSample> samples;

@@ -11,6 +11,7 @@
 #include "evio/core/error.h"
 #include "evio/core/io/events_h5_raw.h"
 #include "evio/core/random_stream.h"
+#include "error_of.h"
 #include "temp_dir.h"
 
 namespace evio::io {
@@ -77,14 +78,7 @@ void writeInPieces(const std::string& path, const EventArray& ev, const EventH5O
   w.close();
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "<no error>";
-}
+using test::errorOf;
 
 #define EXPECT_CONTAINS(text, part) \
   EXPECT_NE(std::string(text).find(part), std::string::npos) << "'" << (text) << "' lacks '" << (part) << "'"

@@ -13,6 +13,7 @@
 #include "evio/core/error.h"
 #include "evio/core/io/media_module.h"
 #include "evio/core/io/png_codec.h"
+#include "error_of.h"
 
 namespace evio {
 namespace {
@@ -48,14 +49,7 @@ bool samePixels(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::errorOf;
 
 /// libpng writes the layouts OpenCV cannot: palette with transparency, grey
 /// with alpha, Adam7 interlacing, 2-bit grey. Returns the file's bytes.

@@ -17,6 +17,7 @@
 #include "evio/experiments/child_process.h"
 #include "evio/experiments/metrics_format.h"
 #include "evio/experiments/slurm_script.h"
+#include "error_of.h"
 #include "temp_dir.h"
 
 namespace evio::experiments {
@@ -24,14 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::errorOf;
 
 /// A campaign whose steps are shell one-liners: "simulate" writes the
 /// sequence and counts itself in <dir>/simulations, "estimate" fails with

@@ -11,6 +11,7 @@
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/io/tum.h"
 #include "evio/experiments/track_metrics.h"
+#include "error_of.h"
 #include "temp_dir.h"
 
 namespace evio::experiments {
@@ -193,16 +194,7 @@ TEST(DepthTrackTruth, TracksWithoutTruthAreUnevaluable) {
   EXPECT_NE(json.find("\"unevaluable_tracks\": 3"), std::string::npos) << json;
 }
 
-/// Runs `f` and returns the evio::Error message it throws ("" if none).
-template <class F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::errorOf;
 
 TEST(DepthTrackTruth, BadInputIsOneClearError) {
   const Sequence seq(pinhole());

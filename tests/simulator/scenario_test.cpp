@@ -9,6 +9,7 @@
 #include "evio/scenes/scene.h"
 #include "evio/simulator/renderer.h"
 #include "evio/simulator/scenario.h"
+#include "error_of.h"
 
 namespace evio::simulator {
 namespace {
@@ -27,14 +28,7 @@ std::string scenarioPath(const std::string& name) {
   return std::string(EVIO_SOURCE_DIR) + "/experiments/scenarios/" + name + ".yaml";
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::errorOf;
 
 TEST(Scenario, EveryShippedScenarioLoadsAndItsResolvedFormRoundTrips) {
   for (const auto& name : shippedScenarios()) {

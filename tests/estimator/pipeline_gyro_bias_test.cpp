@@ -72,11 +72,15 @@ TEST(PipelineGyroBias, TheWindowFindsTheSimulatedBiasAndTheFilterStartsAtTheInit
 }
 
 TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
-  // The flight preset's first 2 s on the ground: the window's IMU is at rest,
-  // so its mean rate gives the simulated 4.1 °/s bias to its white noise,
-  // σ_g/√T (the tiny rig's σ_g = 2e-4 rad/s/√Hz, T = 1 s: 0.011 °/s), and the
-  // filter starts with that covariance, not the prior's 6 °/s, at the
-  // window's end. With the rest
+  // The flight preset's first 2 s on the ground: the window's IMU is at rest
+  // (no 50 ms block's mean moves), so its mean rate gives the simulated
+  // 4.1 °/s bias to its white noise, σ_g/√T (the tiny rig's σ_g = 2e-4
+  // rad/s/√Hz, T = 1 s: 0.0115 °/s), plus the still test's allowance for a
+  // drift it could not see, 4 σ_b / √3 with σ_b = σ_g √(1000/50) (0.1183
+  // °/s): 0.1189 °/s per axis, and the filter starts with that covariance,
+  // not the prior's 6 °/s, at the window's end. With the spread test alone
+  // (init.gyro_bias_window_rest_prefix_s = 0) there is no allowance and no
+  // image test: 0.0115 °/s. With the rest
   // test off the same window goes to the tracks (a camera at rest shows a
   // rotation error too: the tracks find the bias, and the filter keeps the
   // prior's σ, since it takes the tracks again).
@@ -93,9 +97,22 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   EXPECT_NEAR(nsToSeconds(*r.initialization_t_ns), 1.0, 0.01);
   const Vec3 d = r.gyro_bias->b_g - kTrueBias;
   const double sigma = std::sqrt(r.gyro_bias->covariance(0, 0));
-  EXPECT_LT(sigma, 0.02 * M_PI / 180.0);
+  const double white = 2e-4 / std::sqrt(1.0), allowance = 4.0 * 2e-4 * std::sqrt(20.0) / std::sqrt(3.0);
+  // The prior's 6 °/s shrinks the posterior below the measurement's σ by
+  // (1 + σ²/σ_prior²)^(-1/2): 0.02 %. The images' still test (the tracks'
+  // 0.5 px of noise, χ²₃ gate) adds the turn it could miss on top, less
+  // than the IMU's allowance here (0.14 °/s in all).
+  EXPECT_GT(sigma, 0.999 * std::hypot(white, allowance));
+  EXPECT_LT(sigma, std::sqrt(2.0) * std::hypot(white, allowance));
+  ASSERT_GT(r.gyro_bias->rest_image_features, 5);
+  EXPECT_LT(r.gyro_bias->rest_image_chi2, 16.27);
   EXPECT_LT(d.dot(r.gyro_bias->covariance.inverse() * d), 16.3);  // χ²₃ 99.9 %
   std::printf("bias at rest: error %.4f deg/s, sigma %.4f deg/s\n", d.norm() * 180.0 / M_PI, sigma * 180.0 / M_PI);
+  PipelineOptions spread_only = windowOptions(1.0);
+  spread_only.init.gyro_bias_window_rest_prefix_s = 0.0;
+  const PipelineResult r_spread = runPipeline(seq, spread_only, dir.file("out_spread"));
+  ASSERT_TRUE(r_spread.gyro_bias.has_value() && r_spread.gyro_bias->at_rest);
+  EXPECT_NEAR(std::sqrt(r_spread.gyro_bias->covariance(0, 0)), white, 0.05 * white);
   // The accelerometer's bias (zero in the tiny rig) comes from the mean force,
   // inside its own 99.9 % ellipsoid, and the summary reports both biases.
   const Vec3& b_a = r.gyro_bias->rest_b_a;
@@ -109,6 +126,68 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   off.init.gyro_bias_window_rest = false;
   const PipelineResult r_off = runPipeline(seq, off, dir.file("out_off"));
   ASSERT_TRUE(r_off.gyro_bias.has_value());
+  EXPECT_FALSE(r_off.gyro_bias->at_rest);
+  EXPECT_TRUE(r_off.gyro_bias->from_tracks);
+}
+
+/// The first time, s, at which the flight preset's motion is plain to the
+/// still-prefix test: acceleration above 0.16 m/s² or rate above 0.008
+/// rad/s, twice the test's thresholds on a 50 ms block's mean (4 σ_b √(1 +
+/// 1/k) ≤ 0.08 m/s² and 0.004 rad/s at the tiny rig's densities).
+double flightPlainMotionS() {
+  const auto traj = test::tinyTrajectory("flight.yaml");
+  for (TimeNs t = traj->startTime(); t < traj->endTime(); t += secondsToNs(0.001)) {
+    const TrajectoryState x = traj->evaluate(t);
+    if (x.a_W.norm() > 0.16 || x.omega_B.norm() > 0.008) return nsToSeconds(t - traj->startTime());
+  }
+  return nsToSeconds(traj->endTime() - traj->startTime());
+}
+
+TEST(PipelineGyroBias, AWindowStillUntilItMovesTakesTheBiasesFromItsStillPrefix) {
+  // The flight preset: 2 s on the ground, then the take-off, a C∞ smoothstep
+  // whose force grows from zero. In a 3.5 s window the still prefix (blocks of
+  // 50 ms whose means do not move, backend/still_prefix.h) ends between the
+  // take-off (one block earlier on a false alarm) and one block after the
+  // motion is plain (flightPlainMotionS). Its mean rate gives the simulated
+  // 4.1 °/s bias inside the 99.9 % ellipsoid of the stated covariance (white
+  // noise over the prefix plus the test's allowance for a drift it could not
+  // see, 0.12 °/s per axis); the filter starts at the prefix's end.
+  test::TempDir dir;
+  const std::string seq = dir.file("seq");
+  test::TinySequenceOptions so;
+  so.duration_s = 4.0;
+  so.gyro_bias_radps = kTrueBias;
+  so.trajectory_preset = "flight.yaml";
+  writeTinySequence(seq, so);
+  const double plain_s = flightPlainMotionS();
+  ASSERT_LT(plain_s + 0.1, 3.5);  // inside the window
+  const PipelineResult r = runPipeline(seq, windowOptions(3.5), dir.file("out"));
+  ASSERT_TRUE(r.status.ok()) << r.status.cause;
+  ASSERT_TRUE(r.gyro_bias.has_value());
+  EXPECT_TRUE(r.gyro_bias->at_rest);
+  EXPECT_TRUE(r.gyro_bias->rest_prefix);
+  EXPECT_FALSE(r.gyro_bias->from_tracks);
+  EXPECT_GE(r.gyro_bias->rest_s, 2.0 - 0.05);
+  EXPECT_LE(r.gyro_bias->rest_s, plain_s + 0.05);
+  ASSERT_TRUE(r.initialization_t_ns.has_value());
+  EXPECT_NEAR(nsToSeconds(*r.initialization_t_ns), r.gyro_bias->rest_s, 0.002);
+  const Vec3 d = r.gyro_bias->b_g - kTrueBias;
+  EXPECT_LT(d.dot(r.gyro_bias->covariance.inverse() * d), 16.3);  // χ²₃ 99.9 %
+  const double sigma = std::sqrt(r.gyro_bias->covariance(0, 0));
+  EXPECT_LT(sigma, 0.15 * M_PI / 180.0);
+  std::printf("still prefix %.3f s (motion plain at %.3f s): bias error %.4f deg/s, sigma %.4f deg/s\n",
+              r.gyro_bias->rest_s, plain_s, d.norm() * 180.0 / M_PI, sigma * 180.0 / M_PI);
+  const std::string summary = io::readFile(dir.file("out/summary.yaml"));
+  EXPECT_NE(summary.find("rest_prefix: true"), std::string::npos);
+
+  // With init.gyro_bias_window_rest_prefix_s = 0 the spread test alone
+  // judges the whole window: the climb's spread fails it, and the window
+  // goes to the tracks.
+  PipelineOptions off = windowOptions(3.5);
+  off.init.gyro_bias_window_rest_prefix_s = 0.0;
+  const PipelineResult r_off = runPipeline(seq, off, dir.file("out_off"));
+  ASSERT_TRUE(r_off.gyro_bias.has_value());
+  EXPECT_FALSE(r_off.gyro_bias->rest_prefix);
   EXPECT_FALSE(r_off.gyro_bias->at_rest);
   EXPECT_TRUE(r_off.gyro_bias->from_tracks);
 }
@@ -217,6 +296,16 @@ TEST(PipelineGyroBias, TheWindowNeedsTheGroundTruthStartAndTwoPairs) {
   o = windowOptions(1.0);
   o.init.gyro_bias_window_sigma = "posterior";
   EXPECT_NE(validationError(o.init).find("gyro_bias_window_sigma"), std::string::npos);
+  // The still prefix: at least two blocks (or 0, off), and a positive block.
+  o = windowOptions(1.0);
+  o.init.gyro_bias_window_rest_prefix_s = 0.08;
+  EXPECT_NE(validationError(o.init).find("gyro_bias_window_rest_prefix_s"), std::string::npos);
+  o.init.gyro_bias_window_rest_prefix_s = -1.0;
+  EXPECT_NE(validationError(o.init).find("gyro_bias_window_rest_prefix_s"), std::string::npos);
+  o.init.gyro_bias_window_rest_prefix_s = 0.0;
+  EXPECT_EQ(validationError(o.init), "");
+  o.init.gyro_bias_window_rest_block_s = 0.0;
+  EXPECT_NE(validationError(o.init).find("gyro_bias_window_rest_block_s"), std::string::npos);
 }
 
 }  // namespace

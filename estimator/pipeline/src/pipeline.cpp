@@ -266,7 +266,12 @@ void PipelineRun::setupStages() {
   } else {
     prefilter_ = std::make_unique<PrefilterStage>(options_.frontend.prefilter, tracker_camera_->camera.width(),
                                                   tracker_camera_->camera.height());
-    frontend_ = std::make_unique<FrontendStage>(options_.frontend, *tracker_camera_);
+    // The frames' word on rest for the window's still test (still_frame_probe.h).
+    const InitOptions& init = options_.init;
+    const bool still_test = init.gyro_bias_window_s > 0.0 && init.gyro_bias_window_rest &&
+                            init.gyro_bias_window_rest_prefix_s > 0.0;
+    const double still_probe_s = still_test ? init.start_offset_s + init.gyro_bias_window_s : 0.0;
+    frontend_ = std::make_unique<FrontendStage>(options_.frontend, *tracker_camera_, still_probe_s);
     sync_ = std::make_unique<SynchronizerStage>(options_.sync);
   }
   backend_ = std::make_unique<Backend>(options_.backend, BackendSensors::fromRig(rig_.rig, tracker_camera_->name));
@@ -293,6 +298,9 @@ void PipelineRun::setupStages() {
     rest.max_acc_std_mps2 = options_.backend.static_max_acc_std_mps2;
     rest.max_gyro_std_radps = options_.backend.static_max_gyro_std_radps;
     rest.noise = options_.backend.imuNoise(rig_.rig.imu);
+    rest.prefix.min_s = options_.init.gyro_bias_window_rest_prefix_s;
+    rest.prefix.block_s = options_.init.gyro_bias_window_rest_block_s;
+    if (method_ == Method::kTracks) rest.still_track_sigma_px = std::max(0.1, options_.tracks.noise_px);
     gyro_bias_window.emplace(options_.init.gyro_bias_window_s, options_.init.gyro_bias_keyframe_s,
                              tracker_camera_->camera, tracker_camera_->T_B_C.rotation(), offset_ns_, rest);
     gyro_bias_window->setTracksOnce(options_.init.gyro_bias_window_tracks_once);

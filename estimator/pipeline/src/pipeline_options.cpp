@@ -21,6 +21,10 @@ void InitOptions::validate() const {
   requirePositive("gyro_bias_keyframe_s", gyro_bias_keyframe_s);
   requireField(gyro_bias_window_s == 0.0 || gyro_bias_keyframe_s * 3.0 <= gyro_bias_window_s, "gyro_bias_keyframe_s",
                "at most a third of gyro_bias_window_s (the estimate needs two keyframe pairs)");
+  requireNonNegative("gyro_bias_window_rest_prefix_s", gyro_bias_window_rest_prefix_s);
+  requirePositive("gyro_bias_window_rest_block_s", gyro_bias_window_rest_block_s);
+  requireField(gyro_bias_window_rest_prefix_s == 0.0 || gyro_bias_window_rest_prefix_s >= 2.0 * gyro_bias_window_rest_block_s,
+               "gyro_bias_window_rest_prefix_s", "0 or at least two blocks (2 x gyro_bias_window_rest_block_s)");
   requireField(gyro_bias_window_sigma == "prior" || gyro_bias_window_sigma == "window", "gyro_bias_window_sigma",
                "must be prior or window (got '" + gyro_bias_window_sigma + "')");
 }

@@ -30,7 +30,14 @@ void emitGyroBias(YAML::Emitter& out, const GyroBiasEstimate& e) {
   out << YAML::Key << "gyro_bias_from_tracks" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "from_tracks" << YAML::Value << e.from_tracks;
   out << YAML::Key << "at_rest" << YAML::Value << e.at_rest;
-  if (e.at_rest) emitSeconds(out, "rest_s", e.rest_s);
+  if (e.at_rest) {
+    emitSeconds(out, "rest_s", e.rest_s);
+    out << YAML::Key << "rest_prefix" << YAML::Value << e.rest_prefix;
+  }
+  if (e.rest_image_features > 0) {
+    out << YAML::Key << "rest_image_features" << YAML::Value << e.rest_image_features;
+    emitSeconds(out, "rest_image_chi2", e.rest_image_chi2);
+  }
   emitVector(out, "b_g_degps", kDeg * e.b_g);
   emitVector(out, "sigma_degps", kDeg * e.covariance.diagonal().cwiseSqrt());
   emitVector(out, "filter_start_sigma_degps", kDeg * e.filter_start_covariance.diagonal().cwiseSqrt());

@@ -25,8 +25,8 @@ void PrefilterStage::process(SequenceItem& in, std::vector<SequenceItem>& out) {
 
 // --- FrontendStage -------------------------------------------------------------------
 
-FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera)
-    : frontend_(options, camera.camera, camera.T_B_C) {
+FrontendStage::FrontendStage(const FrontendOptions& options, const CameraSensor& camera, double still_probe_s)
+    : frontend_(options, camera.camera, camera.T_B_C), still_probe_(still_probe_s) {
   // Segments serve the threads; on one they would only add latency.
   if (options.segment_s > 0.0 && options.threads > 1 && frontend_.tracksEventChunks())
     segment_ns_ = secondsToNs(options.segment_s);
@@ -103,6 +103,7 @@ void FrontendStage::processNow(SequenceItem& in, std::vector<FrontendOutput>& ou
       break;
     case SequenceItem::Kind::kFrame:
       frontend_.addFrame(in.t_ns, in.image);
+      o.still_corners = still_probe_.addFrame(in.t_ns, in.image);
       ++frames_;
       frontend_.drainTrackPoints(o.points);
       o.lag = frontend_.trackLag();
@@ -130,6 +131,7 @@ void SynchronizerStage::process(FrontendOutput& in, std::vector<BackendInput>& o
     case SequenceItem::Kind::kFrame:
       if (in.lag) sync_.setTrackLag(in.lag->a_px, in.lag->tau_s);
       sync_.advanceTime(in.t_ns);
+      if (in.still_corners) out.emplace_back(std::move(*in.still_corners));
       break;
     case SequenceItem::Kind::kImu:
       sync_.advanceTime(in.t_ns);
@@ -239,10 +241,9 @@ void BackendStage::feed(BackendInput& in, std::vector<Estimate>& out) {
     backend_.addMeasurementSet(*set);
     ++measurement_sets_;
     last_set_features_ = set->features.size();
-  } else {
-    const auto& range = std::get<RangeMeasurement>(in);
-    backend_.addRange(range.t_ns, range.range_m);
-  }
+  } else if (const auto* range = std::get_if<RangeMeasurement>(&in)) {
+    backend_.addRange(range->t_ns, range->range_m);
+  }  // FrameCorners: the first window's evidence only (gyro_bias_window.h)
   for (Estimate& e : backend_.takeEstimates()) out.push_back(std::move(e));
 }
 

@@ -14,6 +14,7 @@
 /// the camera clock unless a field says otherwise.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "evio/core/eigen_types.h"
@@ -80,6 +81,14 @@ struct MeasurementSet {
 struct RangeMeasurement {
   TimeNs t_ns = 0;      ///< camera clock
   double range_m = 0.0;
+};
+
+/// Where corners of the first frame are found in one later frame (or the
+/// first itself), by the frontend's still probe (still_frame_probe.h): the
+/// images' evidence of rest for the backend's first window, never an update.
+struct FrameCorners {
+  TimeNs t_ns = 0;                                    ///< camera clock
+  std::vector<std::pair<FeatureId, Vec2>> corners_px;  ///< corner index, position
 };
 
 // IMU readings: evio::ImuSample (core/imu_sample.h), IMU clock, body frame B.

@@ -109,6 +109,13 @@ struct GyroBiasEstimate {
   /// filter starts with their covariance as well.
   bool at_rest = false;
   double rest_s = 0.0;  ///< the readings' span, s
+  /// At rest only from the window's start until it moved (still_prefix.h):
+  /// the filter starts at the prefix's end, rest_s after the window's start.
+  bool rest_prefix = false;
+  /// The images' still test over the rest (still_prefix.h imageRotationRate):
+  /// features used and ωᵀ C⁻¹ ω (0 features: not run or too few).
+  int rest_image_features = 0;
+  double rest_image_chi2 = 0.0;
   /// At rest the accelerometer bias comes from the mean force too (with the
   /// tilt): its posterior mean, m/s², and covariance, (m/s²)².
   Vec3 rest_b_a = Vec3::Zero();

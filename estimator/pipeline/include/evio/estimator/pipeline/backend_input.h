@@ -1,7 +1,9 @@
 #pragma once
 /// @file backend_input.h
 /// What the backend consumes (stages.h): IMU samples (IMU clock), measurement
-/// sets and range readings (camera clock), each stream in time order.
+/// sets and range readings (camera clock), each stream in time order, and
+/// the still probe's frame corners (camera clock), which only the first
+/// window reads (gyro_bias_window.h); the filter never sees them.
 
 #include <variant>
 
@@ -10,6 +12,6 @@
 
 namespace evio::estimator {
 
-using BackendInput = std::variant<ImuSample, MeasurementSet, RangeMeasurement>;
+using BackendInput = std::variant<ImuSample, MeasurementSet, RangeMeasurement, FrameCorners>;
 
 }  // namespace evio::estimator

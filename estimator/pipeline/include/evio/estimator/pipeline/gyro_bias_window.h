@@ -10,13 +10,17 @@
 /// state's, and the buffered inputs are replayed through the filter from the
 /// initial state with that bias as its mean; the bias's covariance stays the
 /// prior's, because the replay gives the filter the window's tracks again.
-/// If the window's IMU readings are at rest (WindowRestTest) and their mean
-/// passes the χ² gate against the prior, they give both biases instead
+/// If the window's IMU readings are at rest (WindowRestTest), throughout or
+/// from its start until they move (the still prefix), and their mean passes
+/// the χ² gate against the prior, they give both biases instead
 /// (static_initializer.h restMeasurement, applyRestMeasurement), with their
-/// covariance, and the window is the initialisation itself: the filter
-/// starts at its end (at rest nothing moved) and only the inputs from then
-/// on are fed, so the readings the rest measurement averaged are not
-/// propagated through again.
+/// covariance, and the rest is the initialisation itself: the filter starts
+/// at its end (at rest nothing moved) and only the inputs from then on are
+/// fed, so the readings the rest measurement averaged are not propagated
+/// through again. Whether the camera was still too is asked of the images:
+/// the informative bearings of the window's measurement sets and the still
+/// probe's frame corners (FrameCorners, frontend/still_frame_probe.h), which
+/// the window keeps and never buffers for the filter.
 /// Memory: one window of inputs.
 
 #include <optional>
@@ -26,6 +30,7 @@
 #include "evio/core/camera/camera.h"
 #include "evio/estimator/backend/gyro_bias_from_tracks.h"
 #include "evio/estimator/backend/static_initializer.h"
+#include "evio/estimator/backend/still_prefix.h"
 #include "evio/estimator/measurements.h"
 #include "evio/estimator/pipeline/backend_input.h"
 
@@ -38,6 +43,16 @@ struct WindowRestTest {
   double max_acc_std_mps2 = 0.1;     ///< per-axis spread bound, m/s²
   double max_gyro_std_radps = 0.02;  ///< rad/s
   ImuNoiseDensities noise;           ///< the filter's IMU noise
+  /// Where the rest ends (backend/still_prefix.h): the whole window if no
+  /// block moves, else a still prefix spanning at least prefix.min_s; the
+  /// rest measurement then carries the test's allowance. prefix.min_s = 0:
+  /// the spread test alone, on the whole window, no allowance.
+  StillPrefixTest prefix{0.05, 4.0, 0.0};
+  /// The still tracks' noise per axis for the images' test, px: a tracker
+  /// on a still scene moves its points by hundredths of a pixel (KLT 0.009
+  /// px, EKLT 0.004 px median over boxes_6dof's first 0.2 s), so 0.1; more
+  /// for a track source with stated noise (the tracks method's noise_px).
+  double still_track_sigma_px = 0.1;
 };
 
 class GyroBiasWindow {
@@ -78,6 +93,21 @@ class GyroBiasWindow {
 
  private:
   void addKeyframe(const MeasurementSet& set, TimeNs t_imu_ns);
+  /// The rest measurement as one update of x0 and P0; on success *e holds
+  /// the biases and restStart() the state at the rest's end.
+  void applyRest(const RestMeasurement& rest, const Eigen::Matrix<double, 15, 15>& P0, GyroBiasEstimate* e);
+  /// Keeps the set's informative bearings for the images' still test.
+  void addStillObservations(const MeasurementSet& set, TimeNs t_imu_ns);
+  /// Keeps the still probe's corners (as negative ids) for the same test.
+  void addStillCorners(const FrameCorners& corners);
+  /// The images' still test up to t1 (backend/still_prefix.h
+  /// imageRotationRate at rest_test.still_track_sigma_px per axis, χ²₃ gate
+  /// at 0.999): kStill adds the rate the gate could miss to rest's gyroscope
+  /// variance; kMoving when the gate fails; kCannotTell with fewer than
+  /// five corners or features seen twice.
+  /// Records the test in *e.
+  enum class ImageVerdict { kStill, kMoving, kCannotTell };
+  ImageVerdict imagesStill(TimeNs t1_ns, RestMeasurement* rest, GyroBiasEstimate* e) const;
 
   double window_s_, keyframe_s_;
   Camera camera_;
@@ -94,6 +124,7 @@ class GyroBiasWindow {
   std::vector<BackendInput> inputs_;
   ImuSamples imu_;
   std::vector<BearingKeyframe> keyframes_;
+  std::vector<BearingObservation> still_observations_;
 };
 
 }  // namespace evio::estimator

@@ -71,6 +71,16 @@ struct InitOptions {
   /// at rest its mean readings give both biases (and the tilt) as one update
   /// of the initial state, with their covariance, instead of the tracks.
   bool gyro_bias_window_rest = true;
+  /// Where the rest ends (backend/still_prefix.h): the window's IMU is cut
+  /// into blocks of gyro_bias_window_rest_block_s and is still up to the
+  /// first block whose mean moves; still throughout, the whole window is
+  /// the rest, else a still prefix at least this long, s, is (the filter
+  /// then starts at the prefix's end and takes the window's later inputs).
+  /// The rest measurement carries the test's allowance for a drift it could
+  /// not see. 0: the spread test alone decides, on the whole window.
+  double gyro_bias_window_rest_prefix_s = 0.1;
+  /// Block length of the still-prefix test, s.
+  double gyro_bias_window_rest_block_s = 0.05;
   /// Use the window's tracks once: the filter takes the tracks' bias with
   /// its covariance and skips the window's measurement sets (else it keeps
   /// the prior's σ and takes the window's tracks again).
@@ -91,6 +101,9 @@ struct InitOptions {
     v("gyro_bias_window_s", gyro_bias_window_s, "groundtruth: gyroscope bias from this long of tracks first, s (0: off)");
     v("gyro_bias_keyframe_s", gyro_bias_keyframe_s, "keyframe spacing in the gyroscope-bias window, s");
     v("gyro_bias_window_rest", gyro_bias_window_rest, "a window whose IMU is at rest gives both biases from its mean");
+    v("gyro_bias_window_rest_prefix_s", gyro_bias_window_rest_prefix_s,
+      "rest ends at the first block whose mean moves; a still prefix this long counts, s (0: spread test only)");
+    v("gyro_bias_window_rest_block_s", gyro_bias_window_rest_block_s, "block length of the still-prefix test, s");
     v("gyro_bias_window_tracks_once", gyro_bias_window_tracks_once,
       "the filter takes the window's bias with its covariance and skips the window's tracks");
     v("gyro_bias_window_sigma", gyro_bias_window_sigma,

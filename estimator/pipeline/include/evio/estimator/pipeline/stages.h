@@ -22,6 +22,7 @@
 #include "evio/estimator/frontend/eklt_tracker.h"
 #include "evio/estimator/frontend/event_prefilter.h"
 #include "evio/estimator/frontend/frontend.h"
+#include "evio/estimator/frontend/still_frame_probe.h"
 #include "evio/estimator/frontend/synchronizer.h"
 #include "evio/estimator/measurements.h"
 #include "evio/estimator/pipeline/backend_input.h"
@@ -44,6 +45,8 @@ struct FrontendOutput {
   /// kFrame: the frontend's estimate of its tracker's lag after this frame
   /// (frontend.track_lag.estimate), for the synchroniser to compensate.
   std::optional<TrackLag> lag;
+  /// kFrame, in the still probe's span: the first frame's corners here.
+  std::optional<FrameCorners> still_corners;
 };
 
 /// Event pre-filters (event_prefilter.h); other items pass unchanged.
@@ -73,7 +76,9 @@ class PrefilterStage : public Stage<SequenceItem, SequenceItem> {
 /// see exactly what they would see input by input.
 class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
  public:
-  FrontendStage(const FrontendOptions& options, const CameraSensor& camera);
+  /// still_probe_s > 0: the frames of the first still_probe_s also go to a
+  /// StillFrameProbe (still_frame_probe.h), whose corners the outputs carry.
+  FrontendStage(const FrontendOptions& options, const CameraSensor& camera, double still_probe_s = 0.0);
   void process(SequenceItem& in, std::vector<FrontendOutput>& out) override;
   /// At the end of the data: the held inputs leave.
   void finish(std::vector<FrontendOutput>& out) { flushSegment(out); }
@@ -101,6 +106,7 @@ class FrontendStage : public Stage<SequenceItem, FrontendOutput> {
   static constexpr std::size_t kMaxSegmentEvents = std::size_t{1} << 20;  // memory bound at any event rate
 
   Frontend frontend_;
+  StillFrameProbe still_probe_;
   std::uint64_t frames_ = 0;
   TimeNs segment_ns_ = 0;  // 0: no segments
   std::vector<Held> held_;

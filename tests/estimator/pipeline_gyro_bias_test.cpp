@@ -32,12 +32,13 @@ PipelineOptions windowOptions(double window_s, double noise_px = 0.5) {
   return o;
 }
 
-/// 3 s of the tiny rig with the simulated gyroscope bias kTrueBias, written
-/// to `dir`/seq; returns the folder.
-std::string writeBiasedSequence(const test::TempDir& dir, const std::string& trajectory_preset = "six_dof.yaml") {
+/// duration_s of the tiny rig with the simulated gyroscope bias kTrueBias,
+/// written to `dir`/seq; returns the folder.
+std::string writeBiasedSequence(const test::TempDir& dir, const std::string& trajectory_preset = "six_dof.yaml",
+                                double duration_s = 3.0) {
   const std::string seq = dir.file("seq");
   test::TinySequenceOptions so;
-  so.duration_s = 3.0;
+  so.duration_s = duration_s;
   so.gyro_bias_radps = kTrueBias;
   so.trajectory_preset = trajectory_preset;
   writeTinySequence(seq, so);
@@ -73,14 +74,13 @@ TEST(PipelineGyroBias, TheWindowFindsTheSimulatedBiasAndTheFilterStartsAtTheInit
 
 TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   // The flight preset's first 2 s on the ground: the window's IMU is at rest
-  // (no 50 ms block's mean moves), so its mean rate gives the simulated
-  // 4.1 °/s bias to its white noise, σ_g/√T (the tiny rig's σ_g = 2e-4
-  // rad/s/√Hz, T = 1 s: 0.0115 °/s), plus the still test's allowance for a
-  // drift it could not see, 4 σ_b / √3 with σ_b = σ_g √(1000/50) (0.1183
-  // °/s): 0.1189 °/s per axis, and the filter starts with that covariance,
-  // not the prior's 6 °/s, at the window's end. With the spread test alone
-  // (init.gyro_bias_window_rest_prefix_s = 0) there is no allowance and no
-  // image test: 0.0115 °/s. With the rest
+  // (no 50 ms block's mean moves; the frames cannot tell, the tracks method
+  // having none), so its mean rate gives the simulated 4.1 °/s bias to its
+  // white noise, σ_g/√T (the tiny rig's σ_g = 2e-4 rad/s/√Hz, T = 1 s:
+  // 0.0115 °/s; a whole still window carries no allowance), and the filter
+  // starts with that covariance, not the prior's 6 °/s, at the window's
+  // end. The spread test alone (init.gyro_bias_window_rest_prefix_s = 0)
+  // gives the same. With the rest
   // test off the same window goes to the tracks (a camera at rest shows a
   // rotation error too: the tracks find the bias, and the filter keeps the
   // prior's σ, since it takes the tracks again).
@@ -97,14 +97,11 @@ TEST(PipelineGyroBias, AWindowAtRestTakesTheBiasesFromTheMeanReadings) {
   EXPECT_NEAR(nsToSeconds(*r.initialization_t_ns), 1.0, 0.01);
   const Vec3 d = r.gyro_bias->b_g - kTrueBias;
   const double sigma = std::sqrt(r.gyro_bias->covariance(0, 0));
-  const double white = 2e-4 / std::sqrt(1.0), allowance = 4.0 * 2e-4 * std::sqrt(20.0) / std::sqrt(3.0);
+  const double white = 2e-4 / std::sqrt(1.0);
   // The prior's 6 °/s shrinks the posterior below the measurement's σ by
-  // (1 + σ²/σ_prior²)^(-1/2): 0.02 %. The images' still test (the tracks'
-  // 0.5 px of noise, χ²₃ gate) adds the turn it could miss on top, less
-  // than the IMU's allowance here (0.14 °/s in all).
-  EXPECT_GT(sigma, 0.999 * std::hypot(white, allowance));
-  EXPECT_LT(sigma, std::sqrt(2.0) * std::hypot(white, allowance));
-  ASSERT_GT(r.gyro_bias->rest_image_features, 5);
+  // (1 + σ²/σ_prior²)^(-1/2): 2e-6.
+  EXPECT_NEAR(sigma, white, 0.01 * white);
+  ASSERT_GT(r.gyro_bias->rest_image_features, 5);  // the tracks say still too
   EXPECT_LT(r.gyro_bias->rest_image_chi2, 16.27);
   EXPECT_LT(d.dot(r.gyro_bias->covariance.inverse() * d), 16.3);  // χ²₃ 99.9 %
   std::printf("bias at rest: error %.4f deg/s, sigma %.4f deg/s\n", d.norm() * 180.0 / M_PI, sigma * 180.0 / M_PI);
@@ -153,12 +150,7 @@ TEST(PipelineGyroBias, AWindowStillUntilItMovesTakesTheBiasesFromItsStillPrefix)
   // noise over the prefix plus the test's allowance for a drift it could not
   // see, 0.12 °/s per axis); the filter starts at the prefix's end.
   test::TempDir dir;
-  const std::string seq = dir.file("seq");
-  test::TinySequenceOptions so;
-  so.duration_s = 4.0;
-  so.gyro_bias_radps = kTrueBias;
-  so.trajectory_preset = "flight.yaml";
-  writeTinySequence(seq, so);
+  const std::string seq = writeBiasedSequence(dir, "flight.yaml", 4.0);
   const double plain_s = flightPlainMotionS();
   ASSERT_LT(plain_s + 0.1, 3.5);  // inside the window
   const PipelineResult r = runPipeline(seq, windowOptions(3.5), dir.file("out"));

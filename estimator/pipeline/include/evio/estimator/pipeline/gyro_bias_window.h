@@ -44,9 +44,9 @@ struct WindowRestTest {
   double max_gyro_std_radps = 0.02;  ///< rad/s
   ImuNoiseDensities noise;           ///< the filter's IMU noise
   /// Where the rest ends (backend/still_prefix.h): the whole window if no
-  /// block moves, else a still prefix spanning at least prefix.min_s; the
-  /// rest measurement then carries the test's allowance. prefix.min_s = 0:
-  /// the spread test alone, on the whole window, no allowance.
+  /// block moves, else a still prefix spanning at least prefix.min_s, whose
+  /// rest measurement carries the tests' allowances. prefix.min_s = 0: the
+  /// spread test alone, on the whole window.
   StillPrefixTest prefix{0.05, 4.0, 0.0};
   /// The still tracks' noise per axis for the images' test, px: a tracker
   /// on a still scene moves its points by hundredths of a pixel (KLT 0.009
@@ -102,12 +102,12 @@ class GyroBiasWindow {
   void addStillCorners(const FrameCorners& corners);
   /// The images' still test up to t1 (backend/still_prefix.h
   /// imageRotationRate at rest_test.still_track_sigma_px per axis, χ²₃ gate
-  /// at 0.999): kStill adds the rate the gate could miss to rest's gyroscope
-  /// variance; kMoving when the gate fails; kCannotTell with fewer than
-  /// five corners or features seen twice.
+  /// at 0.999): kStill, with the variance of the rate the gate could miss in
+  /// *missed_variance; kMoving when the gate fails; kCannotTell with fewer
+  /// than five corners or features seen twice.
   /// Records the test in *e.
   enum class ImageVerdict { kStill, kMoving, kCannotTell };
-  ImageVerdict imagesStill(TimeNs t1_ns, RestMeasurement* rest, GyroBiasEstimate* e) const;
+  ImageVerdict imagesStill(TimeNs t1_ns, double* missed_variance, GyroBiasEstimate* e) const;
 
   double window_s_, keyframe_s_;
   Camera camera_;

@@ -76,8 +76,8 @@ struct InitOptions {
   /// first block whose mean moves; still throughout, the whole window is
   /// the rest, else a still prefix at least this long, s, is (the filter
   /// then starts at the prefix's end and takes the window's later inputs).
-  /// The rest measurement carries the test's allowance for a drift it could
-  /// not see. 0: the spread test alone decides, on the whole window.
+  /// A prefix's rest measurement carries the tests' allowances for what they
+  /// could not see. 0: the spread test alone decides, on the whole window.
   double gyro_bias_window_rest_prefix_s = 0.1;
   /// Block length of the still-prefix test, s.
   double gyro_bias_window_rest_block_s = 0.05;

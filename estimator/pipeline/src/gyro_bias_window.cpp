@@ -106,41 +106,45 @@ GyroBiasWindow::ImageVerdict GyroBiasWindow::imagesStill(TimeNs t1_ns, double* m
   return ImageVerdict::kStill;
 }
 
+void GyroBiasWindow::tryStillRest(const Eigen::Matrix<double, 15, 15>& P0, GyroBiasEstimate* e) {
+  // Still until it moves: the block test decides where the rest ends (the
+  // window's end, or a prefix at least prefix.min_s long).
+  const std::optional<StillPrefix> prefix = stillPrefix(imu_, rest_test_.noise, rest_test_.prefix);
+  if (!prefix) return;
+  const ImuSamples still = prefix->every_block
+                               ? imu_
+                               : ImuSamples(imu_.begin(), imu_.begin() + static_cast<std::ptrdiff_t>(prefix->readings));
+  std::optional<RestMeasurement> rest = restMeasurement(still, rest_test_.gravity_mps2, rest_test_.max_acc_std_mps2,
+                                                        rest_test_.max_gyro_std_radps, rest_test_.noise);
+  if (!rest) return;
+  // Where the images cannot tell (fewer than five corners or features seen
+  // twice: a helicopter on textureless ground, a run without frames), a
+  // whole still window is taken for rest on the IMU's word, as before; a
+  // prefix is not: it ends where the IMU saw motion begin, and a steady turn
+  // just before it passes every IMU test (5 of 100 prefixes of KLT-VIO runs
+  // that move from their first reading did).
+  double image_missed_variance = 0.0;
+  const ImageVerdict images = imagesStill(rest->t1_ns, &image_missed_variance, e);
+  if (images == ImageVerdict::kMoving || (images == ImageVerdict::kCannotTell && !prefix->every_block)) return;
+  if (!prefix->every_block) {
+    // A prefix ends where motion began: its last blocks may hold the onset
+    // below the thresholds, which the allowances carry. A whole window
+    // showed no onset at all, and keeps the white noise alone (with the
+    // allowances mars_flight's runs lost accuracy: EKLT-VIO 0.40 -> 0.71 %,
+    // HASTE-VIO 10 -> 6 of 10 held).
+    rest->gyro_variance += prefix->gyro_allowance_variance + image_missed_variance;
+    rest->acc_variance += prefix->acc_allowance_variance;
+  }
+  applyRest(*rest, P0, e);
+  e->rest_prefix = e->at_rest && !prefix->every_block;
+}
+
 GyroBiasEstimate GyroBiasWindow::estimate(const Eigen::Matrix<double, 15, 15>& P0) {
   complete_ = true;
   const Mat3 prior_covariance = P0.block<3, 3>(kIdxBg, kIdxBg);
   GyroBiasEstimate e;
   if (rest_test_.enabled && rest_test_.prefix.min_s > 0.0) {
-    // Still until it moves: the block test decides where the rest ends (the
-    // window's end, or a prefix at least prefix.min_s long).
-    if (const std::optional<StillPrefix> prefix = stillPrefix(imu_, rest_test_.noise, rest_test_.prefix)) {
-      const ImuSamples still = prefix->every_block
-                                   ? imu_
-                                   : ImuSamples(imu_.begin(), imu_.begin() + static_cast<std::ptrdiff_t>(prefix->readings));
-      std::optional<RestMeasurement> rest = restMeasurement(still, rest_test_.gravity_mps2, rest_test_.max_acc_std_mps2,
-                                                            rest_test_.max_gyro_std_radps, rest_test_.noise);
-      // Where the images cannot tell (fewer than five corners or features
-      // seen twice: a helicopter on textureless ground, a run without
-      // frames), a whole still window is taken for rest on the IMU's word,
-      // as before; a prefix is not: it ends where the IMU saw motion begin,
-      // and a steady turn just before it passes every IMU test (5 of 100
-      // prefixes of KLT-VIO runs that move from their first reading did).
-      double image_missed_variance = 0.0;
-      const ImageVerdict images = rest ? imagesStill(rest->t1_ns, &image_missed_variance, &e) : ImageVerdict::kMoving;
-      if (images == ImageVerdict::kStill || (images == ImageVerdict::kCannotTell && prefix->every_block)) {
-        if (!prefix->every_block) {
-          // A prefix ends where motion began: its last blocks may hold the
-          // onset below the thresholds, which the allowances carry. A whole
-          // window showed no onset at all, and keeps the white noise alone
-          // (with the allowances mars_flight's runs lost accuracy: EKLT-VIO
-          // 0.40 -> 0.71 %, HASTE-VIO 10 -> 6 of 10 held).
-          rest->gyro_variance += prefix->gyro_allowance_variance + image_missed_variance;
-          rest->acc_variance += prefix->acc_allowance_variance;
-        }
-        applyRest(*rest, P0, &e);
-        e.rest_prefix = e.at_rest && !prefix->every_block;
-      }
-    }
+    tryStillRest(P0, &e);
   } else if (rest_test_.enabled) {
     // The spread test alone on the whole window.
     if (const std::optional<RestMeasurement> rest = restMeasurement(
@@ -155,7 +159,11 @@ GyroBiasEstimate GyroBiasWindow::estimate(const Eigen::Matrix<double, 15, 15>& P
     keyframes_.erase(std::remove_if(keyframes_.begin(), keyframes_.end(),
                                     [&](const BearingKeyframe& k) { return k.t_imu_ns < t_first || k.t_imu_ns > t_last; }),
                      keyframes_.end());
+    const int image_features = e.rest_image_features;  // the images' still test, kept for the summary
+    const double image_chi2 = e.rest_image_chi2;
     e = estimateGyroBiasFromTracks(keyframes_, imu_, R_B_C_, x0_->b_g, prior_covariance, solver_);
+    e.rest_image_features = image_features;
+    e.rest_image_chi2 = image_chi2;
   }
   imu_ = ImuSamples();
   keyframes_ = std::vector<BearingKeyframe>();

@@ -96,6 +96,9 @@ class GyroBiasWindow {
   /// The rest measurement as one update of x0 and P0; on success *e holds
   /// the biases and restStart() the state at the rest's end.
   void applyRest(const RestMeasurement& rest, const Eigen::Matrix<double, 15, 15>& P0, GyroBiasEstimate* e);
+  /// The still test (rest_test_.prefix): on rest, *e holds the biases and
+  /// restStart() the state at the rest's end.
+  void tryStillRest(const Eigen::Matrix<double, 15, 15>& P0, GyroBiasEstimate* e);
   /// Keeps the set's informative bearings for the images' still test.
   void addStillObservations(const MeasurementSet& set, TimeNs t_imu_ns);
   /// Keeps the still probe's corners (as negative ids) for the same test.

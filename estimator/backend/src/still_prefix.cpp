@@ -84,7 +84,7 @@ std::optional<ImageRotationRate> imageRotationRate(const std::vector<BearingObse
                                                    TimeNs t0_ns, TimeNs t1_ns, double sigma_bearing_rad,
                                                    int min_features, double min_span_s) {
   // Each feature's first and last observation inside [t0, t1].
-  std::map<int, std::pair<const BearingObservation*, const BearingObservation*>> ends;
+  std::map<std::int64_t, std::pair<const BearingObservation*, const BearingObservation*>> ends;
   for (const BearingObservation& o : observations) {
     if (o.t_ns < t0_ns || o.t_ns > t1_ns) continue;
     auto [it, inserted] = ends.try_emplace(o.id, &o, &o);

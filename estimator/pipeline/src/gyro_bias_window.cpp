@@ -82,7 +82,7 @@ void GyroBiasWindow::addStillCorners(const FrameCorners& corners) {
     Vec3 bearing;
     // Negative ids: apart from the tracker's features.
     if (camera_.unproject(uv, &bearing))
-      still_observations_.push_back(BearingObservation{t_imu, static_cast<int>(-1 - index), bearing.normalized()});
+      still_observations_.push_back(BearingObservation{t_imu, -1 - index, bearing.normalized()});
   }
 }
 

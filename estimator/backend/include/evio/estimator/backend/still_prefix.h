@@ -17,6 +17,7 @@
 /// bias. applyRestMeasurement's χ² gate against the prior is the guard there.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -46,7 +47,7 @@ std::optional<StillPrefix> stillPrefix(const ImuSamples& samples, const ImuNoise
 /// One feature's unit bearing in the camera at one time.
 struct BearingObservation {
   TimeNs t_ns = 0;
-  int id = 0;
+  std::int64_t id = 0;
   Vec3 bearing = Vec3::UnitZ();
 };
 

@@ -30,7 +30,7 @@ void GyroBiasWindow::open(const ImuState& x0) {
 bool GyroBiasWindow::add(BackendInput in) {
   if (const auto* corners = std::get_if<FrameCorners>(&in)) {
     // Evidence only: kept as bearings, not buffered for the filter.
-    if (rest_test_.enabled && rest_test_.prefix.min_s > 0.0) addStillCorners(*corners);
+    if (stillTestOn()) addStillCorners(*corners);
     return complete_;
   }
   if (const auto* imu = std::get_if<ImuSample>(&in)) {
@@ -41,7 +41,7 @@ bool GyroBiasWindow::add(BackendInput in) {
     if (nsToSeconds(t_imu - x0_->t_ns) > window_s_) {
       complete_ = true;  // the data passed the window's end without an IMU reading
     } else {
-      if (rest_test_.enabled && rest_test_.prefix.min_s > 0.0) addStillObservations(*set, t_imu);
+      if (stillTestOn()) addStillObservations(*set, t_imu);
       if (t_imu >= next_keyframe_ns_) {
         addKeyframe(*set, t_imu);
         while (next_keyframe_ns_ <= t_imu) next_keyframe_ns_ += secondsToNs(keyframe_s_);
@@ -88,9 +88,8 @@ void GyroBiasWindow::addStillCorners(const FrameCorners& corners) {
 
 GyroBiasWindow::ImageVerdict GyroBiasWindow::imagesStill(TimeNs t1_ns, double* missed_variance,
                                                          GyroBiasEstimate* e) const {
-  // A tracker on a still scene moves its points by hundredths of a pixel
-  // (KLT 0.009 px, EKLT 0.004 px median over boxes_6dof's first 0.2 s);
-  // 0.1 px per axis is the noise stated for the test.
+  // The stated noise of still tracks (WindowRestTest::still_track_sigma_px)
+  // as an angle at the focal length.
   const double sigma_rad = rest_test_.still_track_sigma_px / camera_.intrinsics()(0);
   const TimeNs t0 = imu_.empty() ? x0_->t_ns : std::min(x0_->t_ns, imu_.front().t_ns);
   const std::optional<ImageRotationRate> rate = imageRotationRate(still_observations_, t0, t1_ns, sigma_rad);
@@ -143,7 +142,7 @@ GyroBiasEstimate GyroBiasWindow::estimate(const Eigen::Matrix<double, 15, 15>& P
   complete_ = true;
   const Mat3 prior_covariance = P0.block<3, 3>(kIdxBg, kIdxBg);
   GyroBiasEstimate e;
-  if (rest_test_.enabled && rest_test_.prefix.min_s > 0.0) {
+  if (stillTestOn()) {
     tryStillRest(P0, &e);
   } else if (rest_test_.enabled) {
     // The spread test alone on the whole window.

@@ -96,6 +96,8 @@ class GyroBiasWindow {
   /// The rest measurement as one update of x0 and P0; on success *e holds
   /// the biases and restStart() the state at the rest's end.
   void applyRest(const RestMeasurement& rest, const Eigen::Matrix<double, 15, 15>& P0, GyroBiasEstimate* e);
+  /// The still test is on (the rest test with prefix.min_s > 0).
+  bool stillTestOn() const { return rest_test_.enabled && rest_test_.prefix.min_s > 0.0; }
   /// The still test (rest_test_.prefix): on rest, *e holds the biases and
   /// restStart() the state at the rest's end.
   void tryStillRest(const Eigen::Matrix<double, 15, 15>& P0, GyroBiasEstimate* e);

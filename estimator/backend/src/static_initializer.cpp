@@ -50,6 +50,16 @@ std::optional<StaticInitResult> staticInitialize(const ImuSamples& samples, doub
   return out;
 }
 
+double medianRateHz(const ImuSamples& samples) {
+  if (samples.size() < 2) return 0.0;
+  std::vector<TimeNs> spacing;
+  spacing.reserve(samples.size() - 1);
+  for (std::size_t i = 1; i < samples.size(); ++i) spacing.push_back(samples[i].t_ns - samples[i - 1].t_ns);
+  std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
+  const double median_dt = nsToSeconds(spacing[spacing.size() / 2]);
+  return median_dt > 0.0 ? 1.0 / median_dt : 0.0;
+}
+
 std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double gravity_mps2, double max_acc_std_mps2,
                                                double max_gyro_std_radps, const ImuNoiseDensities& noise) {
   if (samples.size() < 2) return std::nullopt;
@@ -65,13 +75,8 @@ std::optional<RestMeasurement> restMeasurement(const ImuSamples& samples, double
   // f: the sensor's rate from the median spacing, so that a gap in the
   // readings does not pass for a slower sensor (the variance of a mean of N
   // readings is σ² f / N, not σ²/T, when some are missing).
-  std::vector<TimeNs> spacing;
-  spacing.reserve(samples.size() - 1);
-  for (std::size_t i = 1; i < samples.size(); ++i) spacing.push_back(samples[i].t_ns - samples[i - 1].t_ns);
-  std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
-  const double median_dt = nsToSeconds(spacing[spacing.size() / 2]);
-  if (!(median_dt > 0.0)) return std::nullopt;
-  const double f = 1.0 / median_dt;
+  const double f = medianRateHz(samples);
+  if (!(f > 0.0)) return std::nullopt;
   const auto bound = [f](double motion, double density) { return std::sqrt(motion * motion + density * density * f); };
   const std::optional<StaticInitResult> still =
       staticInitialize(samples, gravity_mps2, bound(max_acc_std_mps2, noise.accelerometer_noise_density),

@@ -9,21 +9,11 @@
 #include <Eigen/Cholesky>
 
 #include "evio/core/so3.h"
+#include "evio/estimator/backend/static_initializer.h"
 
 namespace evio::estimator {
 
 namespace {
-
-/// The readings' rate from their median spacing, Hz (0 when not positive).
-double medianRate(const ImuSamples& samples) {
-  std::vector<TimeNs> spacing;
-  spacing.reserve(samples.size() - 1);
-  for (std::size_t i = 1; i < samples.size(); ++i) spacing.push_back(samples[i].t_ns - samples[i - 1].t_ns);
-  const auto mid = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
-  std::nth_element(spacing.begin(), mid, spacing.end());
-  const double dt = nsToSeconds(*mid);
-  return dt > 0.0 ? 1.0 / dt : 0.0;
-}
 
 struct BlockMean {
   Vec3 gyro = Vec3::Zero(), acc = Vec3::Zero();
@@ -45,7 +35,7 @@ BlockMean blockMean(const ImuSamples& samples, std::size_t first, std::size_t co
 std::optional<StillPrefix> stillPrefix(const ImuSamples& samples, const ImuNoiseDensities& noise,
                                        const StillPrefixTest& test) {
   if (samples.size() < 4) return std::nullopt;
-  const double f = medianRate(samples);
+  const double f = medianRateHz(samples);
   if (!(f > 0.0)) return std::nullopt;
   const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(test.block_s * f)));
   const std::size_t blocks = samples.size() / n;

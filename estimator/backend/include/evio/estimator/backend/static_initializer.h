@@ -45,6 +45,10 @@ struct RestMeasurement {
   double durationS() const { return nsToSeconds(t1_ns - t0_ns); }
 };
 
+/// The readings' rate from their median spacing, Hz (a gap does not pass
+/// for a slower sensor); 0 for fewer than two readings or no positive spacing.
+double medianRateHz(const ImuSamples& samples);
+
 /// The rest measurement of `samples` when staticInitialize accepts them as
 /// still and they span a positive time; std::nullopt otherwise. The spread
 /// bounds are what motion may add: each is combined in quadrature with the

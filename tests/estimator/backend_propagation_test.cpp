@@ -235,5 +235,66 @@ TEST(BackendInput, OptionsAreValidatedWithTheFieldName) {
   }
 }
 
+
+// The covariance tests. A 3 × 3 velocity block with correlations 0.9, 0.9 and
+// −0.9 is indefinite (determinant 1 − 3·0.81 − 2·0.729 < 0) although every
+// 2 × 2 principal minor is 1 − 0.81 > 0: only the full (Cholesky) test sees it.
+Eigen::Matrix<double, 15, 15> withVelocityBlock(const Mat3& block) {
+  Eigen::Matrix<double, 15, 15> P = Eigen::Matrix<double, 15, 15>::Identity() * 1e-4;
+  P.block<3, 3>(kIdxV, kIdxV) = 0.01 * block;
+  return P;
+}
+
+Mat3 indefiniteWithPositiveMinors() {
+  Mat3 c;
+  c << 1.0, 0.9, 0.9, 0.9, 1.0, -0.9, 0.9, -0.9, 1.0;
+  return c;
+}
+
+BackendStatus statusAfterStillSeconds(const BackendOptions& o, const Eigen::Matrix<double, 15, 15>& P0, double s) {
+  Backend backend(o, testSensors(9.81));
+  ImuState x;
+  x.t_ns = 0;
+  backend.initialize(x, P0);
+  for (TimeNs t = kNsPerMs; t <= secondsToNs(s); t += kNsPerMs) backend.addImu({t, Vec3(0, 0, 9.81), Vec3::Zero()});
+  return backend.status();
+}
+
+TEST(BackendHealth, AnIndefiniteCovarianceIsCaughtByTheFirstFullTestWhateverTheInterval) {
+  for (const double interval_s : {0.0, 0.1, 60.0}) {
+    BackendOptions o;
+    o.max_delay_s = 0.0;
+    o.covariance_check_interval_s = interval_s;
+    const BackendStatus st = statusAfterStillSeconds(o, withVelocityBlock(indefiniteWithPositiveMinors()), 0.01);
+    EXPECT_EQ(st.code, BackendStatus::Code::kDiverged) << interval_s;
+    EXPECT_EQ(st.cause, "covariance not positive semi-definite") << interval_s;
+    EXPECT_EQ(st.t_ns, kNsPerMs) << interval_s;  // the first item after the start
+  }
+}
+
+TEST(BackendHealth, ACorrelationAboveOneIsNamedAtTheFirstItem) {
+  Mat3 c = Mat3::Identity();
+  c(0, 2) = c(2, 0) = 1.001;  // |ρ| > 1 between v_x and v_z
+  BackendOptions o;
+  o.max_delay_s = 0.0;
+  o.covariance_check_interval_s = 60.0;
+  const BackendStatus st = statusAfterStillSeconds(o, withVelocityBlock(c), 0.01);
+  EXPECT_EQ(st.code, BackendStatus::Code::kDiverged);
+  const std::string names = "(variables " + std::to_string(kIdxV) + " and " + std::to_string(kIdxV + 2) + ")";
+  EXPECT_NE(st.cause.find(names), std::string::npos) << st.cause;
+}
+
+TEST(BackendHealth, ASemiDefiniteCovarianceStaysOk) {
+  // Correlation exactly 1 (a clone of the velocity, say) is singular, not indefinite.
+  Mat3 c = Mat3::Constant(1.0);
+  for (const double interval_s : {0.0, 0.1}) {
+    BackendOptions o;
+    o.max_delay_s = 0.0;
+    o.covariance_check_interval_s = interval_s;
+    const BackendStatus st = statusAfterStillSeconds(o, withVelocityBlock(c), 0.5);
+    EXPECT_TRUE(st.ok()) << interval_s << ": " << st.cause;
+  }
+}
+
 }  // namespace
 }  // namespace evio::estimator

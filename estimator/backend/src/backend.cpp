@@ -80,6 +80,7 @@ void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 
   tracks_.clear();
   triangulated_ = TriangulatedPoints(static_cast<std::size_t>(std::max(options_.map_prior_memory, 0)));
   initialized_at_ = state_.imu.t_ns;
+  last_full_covariance_test_ns_ = std::numeric_limits<TimeNs>::min();  // the first test after a start is full
   // The IMU reading at the initial time: interpolated between buffered
   // readings, else held from the nearest one.
   while (imu_buffer_.size() >= 2 && imu_buffer_[1].t_ns <= state.t_ns) imu_buffer_.pop_front();
@@ -302,7 +303,11 @@ void Backend::setStatus(BackendStatus::Code code, const std::string& cause) {
   status_.cause = cause;
 }
 
-void Backend::checkHealth() {
+void Backend::finish() {
+  if (initialized_) checkHealth(true);
+}
+
+void Backend::checkHealth(bool full_test) {
   if (!status_.ok()) return;
   const ImuState& x = state_.imu;
   if (!x.p_W_B.allFinite() || !x.v_W.allFinite() || !x.q_W_B.coeffs().allFinite() || !x.b_g.allFinite() ||
@@ -314,6 +319,15 @@ void Backend::checkHealth() {
                      "velocity " + std::to_string(x.v_W.norm()) + " m/s above max_velocity_mps");
   if ((state_.P.diagonal().array() <= 0.0).any())
     return setStatus(BackendStatus::Code::kDiverged, "covariance with a non-positive variance");
+  if (const auto pair = negativeMinor())
+    return setStatus(BackendStatus::Code::kDiverged,
+                     "covariance not positive semi-definite (variables " + std::to_string(pair->first) + " and " +
+                         std::to_string(pair->second) + ")");
+  const TimeNs interval_ns = secondsToNs(options_.covariance_check_interval_s);
+  const bool due = last_full_covariance_test_ns_ == std::numeric_limits<TimeNs>::min() ||
+                   x.t_ns - last_full_covariance_test_ns_ >= interval_ns;
+  if (!full_test && !due) return;
+  last_full_covariance_test_ns_ = x.t_ns;
   // Right after cloning P is only positive semi-definite (the clone is a
   // function of the IMU state), so the test is a Cholesky factorisation of
   // P + 1e-9 diag(P): it succeeds for every PSD P and fails once an eigenvalue
@@ -323,6 +337,17 @@ void Backend::checkHealth() {
   const Eigen::LLT<MatX> llt(Pr);
   if (llt.info() != Eigen::Success)
     return setStatus(BackendStatus::Code::kDiverged, "covariance not positive semi-definite");
+}
+
+std::optional<std::pair<Eigen::Index, Eigen::Index>> Backend::negativeMinor() const {
+  // A principal submatrix of a positive definite matrix is positive definite:
+  // with D = (1 + 1e-9) diag(P), every P_ij² < D_i D_j when the Cholesky test passes.
+  const MatX& P = state_.P;
+  const double scale = (1.0 + 1e-9) * (1.0 + 1e-9);
+  for (Eigen::Index j = 0; j < P.cols(); ++j)
+    for (Eigen::Index i = j + 1; i < P.rows(); ++i)
+      if (P(i, j) * P(i, j) > scale * P(i, i) * P(j, j)) return std::make_pair(j, i);
+  return std::nullopt;
 }
 
 Estimate Backend::makeEstimate() const {

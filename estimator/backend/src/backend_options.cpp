@@ -67,6 +67,7 @@ void BackendOptions::validate() const {
   requireInRange("max_delay_s", max_delay_s, 0.0, 60.0);  // measurements wait this long in memory
   requireNonNegative("max_late_s", max_late_s);
   requirePositive("max_velocity_mps", max_velocity_mps);
+  requireInRange("covariance_check_interval_s", covariance_check_interval_s, 0.0, 60.0);
   requireNonNegative("range_sigma_m", range_sigma_m);
   requireNonNegative("range_prior_relative_sigma", range_prior_relative_sigma);
   requireNonNegative("range_prior_max_age_s", range_prior_max_age_s);

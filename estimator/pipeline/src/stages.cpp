@@ -185,6 +185,7 @@ void BackendStage::process(BackendInput& in, std::vector<Estimate>& out) {
 
 void BackendStage::finish(std::vector<Estimate>& out) {
   if (window_ && window_->collecting()) closeWindow(out);
+  backend_.finish();
 }
 
 void BackendStage::closeWindow(std::vector<Estimate>& out) {

@@ -93,6 +93,9 @@ class Backend {
   void addRange(TimeNs t_ns, double range_m);
   /// A zero-velocity pseudo-measurement (e.g. the event rate says the camera is still), camera clock.
   void addZeroVelocity(TimeNs t_ns);
+  /// The end of the input: the full covariance test once more (it runs at
+  /// most every covariance_check_interval_s of filter time while input comes).
+  void finish();
 
   // Output --------------------------------------------------------------------------
   const BackendStatus& status() const { return status_; }
@@ -135,7 +138,13 @@ class Backend {
   /// newest clone, the tracks' observations in it are dropped.
   void marginalizeClone(std::size_t i);
 
-  void checkHealth();
+  /// Divergence tests of the state and covariance; `full_test` forces the
+  /// Cholesky test of the whole covariance (else it runs once per
+  /// covariance_check_interval_s of filter time).
+  void checkHealth(bool full_test = false);
+  /// The first 2 × 2 principal minor of P + 1e-9 diag(P) that is negative
+  /// (its variables i < j), if any: O(n²), implied by the Cholesky test.
+  std::optional<std::pair<Eigen::Index, Eigen::Index>> negativeMinor() const;
   void setStatus(BackendStatus::Code code, const std::string& cause);
   Estimate makeEstimate() const;
   UpdaterContext updaterContext() {
@@ -165,6 +174,7 @@ class Backend {
   bool have_imu_at_state_ = false;
   ImuSample last_imu_;
   bool have_last_imu_ = false;
+  TimeNs last_full_covariance_test_ns_ = std::numeric_limits<TimeNs>::min();
 
   std::map<std::pair<TimeNs, std::uint64_t>, Item> pending_;
   TimeNs last_set_t_ = std::numeric_limits<TimeNs>::min();

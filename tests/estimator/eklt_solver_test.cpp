@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "evio/core/error.h"
+#include "evio/estimator/frontend/eklt_options.h"
 #include "evio/estimator/frontend/log_image.h"
 #include "numeric_jacobian.h"
 #include "synthetic_events.h"
@@ -326,15 +327,18 @@ TEST(EkltSolver, LevenbergMarquardtAgreesWithCeres) {
   RecordProperty("max_position_difference_px", std::to_string(max_diff));
 }
 
-// Looser stopping rules for the hot path (|Δcost| ≤ 1e-4·cost, ‖δp‖ ≤ 1e-5·‖p‖,
-// about 10⁻³ px) still land within 0.01 px of the Ceres reference run with its
-// default tolerances, in fewer iterations.
+// The tracker's looser stopping rules for the hot path (EkltOptions:
+// |Δcost| ≤ 1e-3·cost, ‖δp‖ ≤ 1e-5·‖p‖, about 10⁻³ px) still land within
+// 0.01 px of the Ceres reference run with its default tolerances (1e-6,
+// 1e-8), in fewer iterations (at most 0.0006 px apart here, 3.6 iterations
+// a batch against 5.1 at the tight tolerances).
 TEST(EkltSolver, LooseToleranceLmStaysWithinAHundredthOfAPixelOfCeres) {
   Fixture f;
   const EventArray events = test::generateEvents(f.tex, f.motion, test::Roi{25, 15, 85, 70}, 0.0, 0.6, 1e-3, 0.02);
   EkltSolverSettings loose;
-  loose.function_tolerance = 1e-4;
-  loose.parameter_tolerance = 1e-5;
+  loose.function_tolerance = EkltOptions{}.function_tolerance;
+  loose.parameter_tolerance = EkltOptions{}.parameter_tolerance;
+  double max_difference_px = 0.0;
   int iterations_loose = 0, iterations_tight = 0;
   for (int k = 0; k < 20; ++k) {
     const double ta = 0.02 + 0.028 * k;
@@ -350,12 +354,15 @@ TEST(EkltSolver, LooseToleranceLmStaysWithinAHundredthOfAPixelOfCeres) {
         << "batch " << k;
     const EkltSolution tight = solveEkltLm(batch, p0, {});
     const EkltSolution ceres = solveEkltCeres(batch, p0, {});
-    EXPECT_LT((ekltFeaturePosition(fast.p, c_acc, f.x0) - ekltFeaturePosition(ceres.p, c_acc, f.x0)).norm(), 0.01)
-        << "batch " << k;
+    const double difference_px =
+        (ekltFeaturePosition(fast.p, c_acc, f.x0) - ekltFeaturePosition(ceres.p, c_acc, f.x0)).norm();
+    EXPECT_LT(difference_px, 0.01) << "batch " << k;
+    max_difference_px = std::max(max_difference_px, difference_px);
     iterations_loose += fast.iterations;
     iterations_tight += tight.iterations;
   }
   EXPECT_LT(iterations_loose, iterations_tight);
+  RecordProperty("max_position_difference_px", std::to_string(max_difference_px));
   RecordProperty("iterations_loose", std::to_string(iterations_loose / 20.0));
   RecordProperty("iterations_tight", std::to_string(iterations_tight / 20.0));
 }

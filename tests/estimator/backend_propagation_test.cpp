@@ -235,7 +235,6 @@ TEST(BackendInput, OptionsAreValidatedWithTheFieldName) {
   }
 }
 
-
 // The covariance tests. A 3 × 3 velocity block with correlations 0.9, 0.9 and
 // −0.9 is indefinite (determinant 1 − 3·0.81 − 2·0.729 < 0) although every
 // 2 × 2 principal minor is 1 − 0.81 > 0: only the full (Cholesky) test sees it.
@@ -284,16 +283,57 @@ TEST(BackendHealth, ACorrelationAboveOneIsNamedAtTheFirstItem) {
   EXPECT_NE(st.cause.find(names), std::string::npos) << st.cause;
 }
 
+/// The status after `finish()` on a backend started with P0 and given no
+/// input: the end-of-input test on P0 exactly (no process noise added).
+BackendStatus statusAtFinish(const BackendOptions& o, const Eigen::Matrix<double, 15, 15>& P0) {
+  Backend backend(o, testSensors(9.81));
+  ImuState x;
+  x.t_ns = 0;
+  backend.initialize(x, P0);
+  backend.finish();
+  return backend.status();
+}
+
+TEST(BackendHealth, TheEndOfTheInputRunsTheFullTest) {
+  BackendOptions o;
+  o.covariance_check_interval_s = 60.0;
+  const BackendStatus st = statusAtFinish(o, withVelocityBlock(indefiniteWithPositiveMinors()));
+  EXPECT_EQ(st.code, BackendStatus::Code::kDiverged);
+  EXPECT_EQ(st.cause, "covariance not positive semi-definite");
+}
+
 TEST(BackendHealth, ASemiDefiniteCovarianceStaysOk) {
-  // Correlation exactly 1 (a clone of the velocity, say) is singular, not indefinite.
-  Mat3 c = Mat3::Constant(1.0);
+  // Correlation exactly 1 (a clone of the velocity, say) is singular, not
+  // indefinite: both the minors and the Cholesky test of P + 1e-9 diag(P)
+  // accept it, tested on P0 exactly and after half a second of propagation.
+  const Mat3 c = Mat3::Constant(1.0);
+  BackendOptions o;
+  o.max_delay_s = 0.0;
+  EXPECT_TRUE(statusAtFinish(o, withVelocityBlock(c)).ok()) << statusAtFinish(o, withVelocityBlock(c)).cause;
   for (const double interval_s : {0.0, 0.1}) {
-    BackendOptions o;
-    o.max_delay_s = 0.0;
     o.covariance_check_interval_s = interval_s;
     const BackendStatus st = statusAfterStillSeconds(o, withVelocityBlock(c), 0.5);
     EXPECT_TRUE(st.ok()) << interval_s << ": " << st.cause;
   }
+}
+
+TEST(BackendHealth, ARestartTestsItsCovarianceAtOnce) {
+  // A long interval and a healthy first start; the second start's indefinite
+  // P0 is caught at its first item, not 60 s after the first start's test.
+  BackendOptions o;
+  o.max_delay_s = 0.0;
+  o.covariance_check_interval_s = 60.0;
+  Backend backend(o, testSensors(9.81));
+  ImuState x;
+  x.t_ns = 0;
+  backend.initialize(x, withVelocityBlock(Mat3::Identity()));
+  for (TimeNs t = kNsPerMs; t <= 10 * kNsPerMs; t += kNsPerMs) backend.addImu({t, Vec3(0, 0, 9.81), Vec3::Zero()});
+  ASSERT_TRUE(backend.status().ok());
+  x.t_ns = 10 * kNsPerMs;
+  backend.initialize(x, withVelocityBlock(indefiniteWithPositiveMinors()));
+  backend.addImu({11 * kNsPerMs, Vec3(0, 0, 9.81), Vec3::Zero()});
+  EXPECT_EQ(backend.status().code, BackendStatus::Code::kDiverged);
+  EXPECT_EQ(backend.status().t_ns, 11 * kNsPerMs);
 }
 
 }  // namespace

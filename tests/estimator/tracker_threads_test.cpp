@@ -260,8 +260,8 @@ TEST(HasteThreads, ChunksTrackedAsSegmentsGiveEachChunkItsOwnPointsForAnyThreadC
 // the four-pixel AVX path give the same hash; single precision: the
 // AVX-512, AVX and baseline lanes do (eklt_solver_test). Both last re-pinned
 // when the optimiser's function tolerance went from 1e-4 to 1e-3
-// (experiments/campaigns/eklt_tolerance.yaml: every cell's accuracy kept,
-// README "Real time (issue 22)"). A change that is meant to alter the numbers must
+// (experiments/campaigns/eklt_tolerance.yaml: every cell's accuracy
+// statistically unchanged, README "Real time (issue 22)"). A change that is meant to alter the numbers must
 // say so, show the accuracy is kept and update the values here.
 TEST(EkltThreads, SingleThreadOutputIsPinned) {
   for (const bool single : {true, false}) {

@@ -341,12 +341,15 @@ void Backend::checkHealth(bool full_test) {
 
 std::optional<std::pair<Eigen::Index, Eigen::Index>> Backend::negativeMinor() const {
   // A principal submatrix of a positive definite matrix is positive definite:
-  // with D = (1 + 1e-9) diag(P), every P_ij² < D_i D_j when the Cholesky test passes.
+  // with D = (1 + 1e-9) diag(P), every P_ij² < D_i D_j when the Cholesky test
+  // passes. The extra 1e-10 keeps this test strictly weaker than the
+  // factorisation, whose own rounding is about n·2⁻⁵³ (1e-14 here).
   const MatX& P = state_.P;
-  const double scale = (1.0 + 1e-9) * (1.0 + 1e-9);
+  const VecX variance = P.diagonal();
+  const double scale = (1.0 + 1e-9) * (1.0 + 1e-9) * (1.0 + 1e-10);
   for (Eigen::Index j = 0; j < P.cols(); ++j)
     for (Eigen::Index i = j + 1; i < P.rows(); ++i)
-      if (P(i, j) * P(i, j) > scale * P(i, i) * P(j, j)) return std::make_pair(j, i);
+      if (P(i, j) * P(i, j) > scale * variance(i) * variance(j)) return std::make_pair(j, i);
   return std::nullopt;
 }
 

@@ -123,6 +123,9 @@ TEST(BackendStaticInit, RecoversTiltAndGyroBiasFromStillReadings) {
   EXPECT_TRUE(automatic.initialized());
 }
 
+/// A still IMU reading (level body, Earth gravity, no turn) at time t.
+ImuSample stillReading(TimeNs t) { return {t, Vec3(0, 0, 9.81), Vec3::Zero()}; }
+
 class BackendBadInput : public ::testing::Test {
  protected:
   BackendBadInput() : backend_(options(), testSensors(9.81)) {
@@ -135,7 +138,7 @@ class BackendBadInput : public ::testing::Test {
     o.max_delay_s = 0.0;
     return o;
   }
-  static ImuSample still(TimeNs t) { return {t, Vec3(0, 0, 9.81), Vec3::Zero()}; }
+  static ImuSample still(TimeNs t) { return stillReading(t); }
   Backend backend_;
 };
 
@@ -255,7 +258,7 @@ BackendStatus statusAfterStillSeconds(const BackendOptions& o, const Eigen::Matr
   ImuState x;
   x.t_ns = 0;
   backend.initialize(x, P0);
-  for (TimeNs t = kNsPerMs; t <= secondsToNs(s); t += kNsPerMs) backend.addImu({t, Vec3(0, 0, 9.81), Vec3::Zero()});
+  for (TimeNs t = kNsPerMs; t <= secondsToNs(s); t += kNsPerMs) backend.addImu(stillReading(t));
   return backend.status();
 }
 
@@ -327,11 +330,11 @@ TEST(BackendHealth, ARestartTestsItsCovarianceAtOnce) {
   ImuState x;
   x.t_ns = 0;
   backend.initialize(x, withVelocityBlock(Mat3::Identity()));
-  for (TimeNs t = kNsPerMs; t <= 10 * kNsPerMs; t += kNsPerMs) backend.addImu({t, Vec3(0, 0, 9.81), Vec3::Zero()});
+  for (TimeNs t = kNsPerMs; t <= 10 * kNsPerMs; t += kNsPerMs) backend.addImu(stillReading(t));
   ASSERT_TRUE(backend.status().ok());
   x.t_ns = 10 * kNsPerMs;
   backend.initialize(x, withVelocityBlock(indefiniteWithPositiveMinors()));
-  backend.addImu({11 * kNsPerMs, Vec3(0, 0, 9.81), Vec3::Zero()});
+  backend.addImu(stillReading(11 * kNsPerMs));
   EXPECT_EQ(backend.status().code, BackendStatus::Code::kDiverged);
   EXPECT_EQ(backend.status().t_ns, 11 * kNsPerMs);
 }

@@ -255,7 +255,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   RendererOptions ro;
   ro.threads = o.threads;
   ro.supersampling = o.sampling.supersampling;
-  ro.tile_px = o.sampling.tile_px;
+  ro.tile_px = o.sampling.tilePx();
   const Renderer renderer(scene, event_cam, ro);
   std::optional<Renderer> frame_renderer;
   const bool frames = fo.enabled;
@@ -270,7 +270,7 @@ RenderLoopResult runRenderLoop(const Scenario& scenario, const scenes::Scene& sc
   const bool tile_mode = o.sampling.tiles();
   std::optional<TileSchedule> tile_schedule;
   if (tile_mode)
-    tile_schedule.emplace(event_cam.width(), event_cam.height(), o.sampling.tile_px, samplerOptions(o.sampling),
+    tile_schedule.emplace(event_cam.width(), event_cam.height(), o.sampling.tilePx(), samplerOptions(o.sampling),
                           std::min(eo.threshold_pos, eo.threshold_neg), eo.logEpsilon(), scenario.start_ns,
                           o.sampling.tileQuantumNs(), o.threads);
   stats->schedule = o.sampling.schedule;

@@ -159,6 +159,7 @@ Scenario loadScenarioDocument(config::Document doc, const std::string& base_dir,
   doc.root.remove("version");
   if (rig_node.IsMap()) doc.root["rig"].remove("event_camera");
   config::fill(doc, "", o);
+  o.sampling.tile_px = o.sampling.tilePx();  // the resolved YAML states the tile in use
 
   // 3. The trajectory, with the scenario's seed.
   if (!traj_node.IsDefined() || traj_node.IsNull()) throw Error(doc.file + ": trajectory: missing");

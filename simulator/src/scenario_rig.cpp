@@ -99,7 +99,7 @@ void RenderScheduleOptions::validate() const {
                "must be in (0, 1]");
   requireInRange("supersampling", supersampling, 1, 8);
   requireField(schedule == "whole_frame" || schedule == "tiles", "schedule", "must be whole_frame or tiles");
-  requireInRange("tile_px", tile_px, 1, 256);
+  requireField(tile_px == 0 || (tile_px >= 1 && tile_px <= 256), "tile_px", "must be 0 (by schedule) or in [1, 256]");
   requireField(tile_quantum_s == 0.0 || (tile_quantum_s >= 1e-6 && tile_quantum_s <= 1.0 / min_rate_hz),
                "tile_quantum_s", "must be 0 or in [1e-6, 1 / min_rate_hz] s");
 }

@@ -78,6 +78,27 @@ TEST(Scenario, OverridesReachPresetSections) {
   EXPECT_EQ(yaml.find("\nthreads:"), std::string::npos) << "threads never change the output";
 }
 
+TEST(Scenario, TileEdgeDefaultsBySchedule) {
+  // tile_px 0 (the default): 16 px for whole frames (their events depend
+  // slightly on the renderer's tile, so it stays what it was), 8 px for the
+  // tile schedule; the resolved YAML states the tile in use, and a tile set
+  // explicitly is kept with either schedule.
+  const auto tile = [](const std::vector<std::string>& overrides) {
+    const Scenario s = loadScenario(scenarioPath("mars_yard_circle"), overrides, EVIO_SOURCE_DIR);
+    EXPECT_EQ(s.options.sampling.tilePx(), s.options.sampling.tile_px);
+    EXPECT_NE(s.resolvedYaml().find("tile_px: " + std::to_string(s.options.sampling.tile_px)), std::string::npos);
+    return s.options.sampling.tile_px;
+  };
+  EXPECT_EQ(tile({}), 16);
+  EXPECT_EQ(tile({"sampling.schedule=tiles"}), 8);
+  EXPECT_EQ(tile({"sampling.schedule=tiles", "sampling.tile_px=16"}), 16);
+  EXPECT_EQ(tile({"sampling.tile_px=4"}), 4);
+  RenderScheduleOptions unresolved;  // built in code, not loaded
+  EXPECT_EQ(unresolved.tilePx(), 16);
+  unresolved.schedule = "tiles";
+  EXPECT_EQ(unresolved.tilePx(), 8);
+}
+
 TEST(Scenario, BadInputNamesFileLineAndField) {
   const std::string base = R"(
 scene: scenes/presets/ec_shapes.yaml
@@ -97,6 +118,9 @@ rig:
   e = load("sampling: {schedule: tile}\n");
   EXPECT_NE(e.find("sampling.schedule"), std::string::npos) << e;
   EXPECT_NE(e.find("whole_frame or tiles"), std::string::npos) << e;
+  e = load("sampling: {tile_px: -1}\n");
+  EXPECT_NE(e.find("sampling.tile_px"), std::string::npos) << e;
+  EXPECT_NE(e.find("0 (by schedule)"), std::string::npos) << e;
   e = load("sampling: {tile_quantum_s: 1}\n");
   EXPECT_NE(e.find("tile_quantum_s"), std::string::npos) << e;
   e = load("duration_s: 100\n");  // the hover preset lasts 60 s

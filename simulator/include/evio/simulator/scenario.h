@@ -175,7 +175,12 @@ struct RenderScheduleOptions {
   double max_rate_hz = 1000.0;        ///< at most this often (cost bound), Hz (per tile with "tiles")
   bool rate_bound = true;             ///< predict with max neighbour slope · |flow| (else |∇L · flow|)
   double fastest_pixel_quantile = 1.0;///< q ∈ (0, 1]: 1 = the fastest pixel ("whole_frame" only)
-  int tile_px = 16;                   ///< render tile edge, px (the schedule's tiles with "tiles"); the renderer's default
+  /// Render tile edge, px: the renderer's work unit and, with "tiles", the
+  /// schedule's tiles. 0 = by schedule: 16 px for "whole_frame" (whose
+  /// events depend slightly on it: a few rays' bits change with the ray
+  /// streams, docs/simulation.md) and 8 px for "tiles" (fewer rays than 16 px
+  /// where the rates differ within a tile; README "Simulation (issue 5)").
+  int tile_px = 0;
   double tile_quantum_s = 0.0;        ///< "tiles": due times on a grid of this period, s; 0 = 1 / max_rate_hz
   int supersampling = 1;              ///< n × n radiance rays per pixel
 
@@ -187,12 +192,14 @@ struct RenderScheduleOptions {
     v("max_rate_hz", max_rate_hz, "maximum render rate, Hz");
     v("rate_bound", rate_bound, "predict with max neighbour slope * |flow| (else |grad L . flow|)");
     v("fastest_pixel_quantile", fastest_pixel_quantile, "pixel quantile of the predicted rate (1 = fastest)");
-    v("tile_px", tile_px, "render tile edge, px (the schedule's tiles with schedule: tiles)");
+    v("tile_px", tile_px, "render tile edge, px (the schedule's tiles with schedule: tiles); 0 = 16 whole_frame, 8 tiles");
     v("tile_quantum_s", tile_quantum_s, "tiles: due times on a grid of this period, s (0 = 1 / max_rate_hz)");
     v("supersampling", supersampling, "n x n radiance rays per pixel");
   }
   void validate() const;
   bool tiles() const { return schedule == "tiles"; }
+  /// The tile edge in use, px: tile_px, or the schedule's default when 0.
+  int tilePx() const { return tile_px > 0 ? tile_px : (tiles() ? 8 : 16); }
   /// The grid period of the "tiles" schedule, ns.
   TimeNs tileQuantumNs() const;
 };

@@ -136,6 +136,31 @@ TEST(BackendSteps, SlamCandidatesAreTheLongestLiveTracksTiesByTheSmallerId) {
   EXPECT_EQ(chooseSlamCandidates(tracks, 10, 5, 2), (std::vector<FeatureId>{4, 3, 5, 2}));
 }
 
+TEST(BackendSteps, SlamCandidatesBySpanNeedTheSpanAndThreeObservations) {
+  // Clones 6..10 at 0, 0.1, 0.3, 0.4 and 0.5 s; newest 10. Track 1: three
+  // observations over 0.5 s; 3: three over 0.2 s; 2: two over 0.5 s.
+  FilterState state;
+  const double t_s[] = {0.0, 0.1, 0.3, 0.4, 0.5};
+  for (int k = 0; k < 5; ++k) {
+    CameraClone c;
+    c.id = 6 + k;
+    c.t_ns = secondsToNs(t_s[k]);
+    state.clones.push_back(c);
+  }
+  const TrackMap tracks = tracksOf({track(1, {6, 8, 10}), track(2, {6, 10}), track(3, {8, 9, 10})});
+  const auto choose = [&](double span_s) {
+    return chooseSlamCandidates(tracks, state, 10, 5, SlamEligibility{10, secondsToNs(span_s), 3});
+  };
+  EXPECT_TRUE(choose(0.0).empty());                             // off: ten observations, none has them
+  EXPECT_EQ(choose(0.45), (std::vector<FeatureId>{1}));         // 0.5 s >= 0.45 s
+  EXPECT_EQ(choose(0.5), (std::vector<FeatureId>{1}));          // the bound itself counts
+  EXPECT_EQ(choose(0.2), (std::vector<FeatureId>{1, 3}));       // track 2: two observations only
+  EXPECT_TRUE(choose(0.51).empty());
+  // The count rule still applies beside the span rule.
+  EXPECT_EQ(chooseSlamCandidates(tracks, state, 10, 5, SlamEligibility{2, secondsToNs(0.45), 3}),
+            (std::vector<FeatureId>{1, 3, 2}));
+}
+
 TEST(BackendSteps, MsckfTracksAreThoseLeavingTheWindowAndTheLostOnes) {
   // Oldest clone 0, newest 4. Track 1 starts in the oldest clone (leaves when
   // sliding); 2 too; but 2 is a SLAM candidate; 3 is lost; 4 is lost and short;

@@ -33,6 +33,7 @@ void BackendOptions::validate() const {
   requireField(map_prior_memory >= 1 && map_prior_memory <= 100000, "map_prior_memory", "must be in [1, 100000]");
   requireField(map_prior_min_points >= 1, "map_prior_min_points", "must be >= 1");
   requireField(slam_min_track_length >= 1, "slam_min_track_length", "must be >= 1");
+  requireField(slam_min_track_span_s >= 0.0 && slam_min_track_span_s <= 60.0, "slam_min_track_span_s", "must be in [0, 60] s");
   requireField(slam_gate_probability > 0.0 && slam_gate_probability < 1.0, "slam_gate_probability",
                "must be in (0, 1)");
   requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");

@@ -1,6 +1,7 @@
 #include "evio/estimator/backend/feature_selection.h"
 
 #include <algorithm>
+#include <optional>
 #include <utility>
 
 #include <Eigen/Cholesky>
@@ -69,6 +70,34 @@ std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, std::int64_t
   for (const auto& [id, track] : tracks)
     if (isObservedIn(track, clone_id) && static_cast<int>(track.observations.size()) >= min_length)
       eligible.emplace_back(track.observations.size(), id);
+  std::sort(eligible.begin(), eligible.end(),
+            [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+  for (int k = 0; k < free_slots && k < static_cast<int>(eligible.size()); ++k)
+    out.push_back(eligible[static_cast<std::size_t>(k)].second);
+  return out;
+}
+
+std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, const FilterState& state, std::int64_t clone_id,
+                                            int free_slots, const SlamEligibility& rule) {
+  if (rule.min_span_ns <= 0) return chooseSlamCandidates(tracks, clone_id, free_slots, rule.min_length);
+  std::vector<FeatureId> out;
+  if (free_slots <= 0) return out;
+  const auto cloneTime = [&state](std::int64_t id) -> std::optional<TimeNs> {
+    for (const auto& c : state.clones)
+      if (c.id == id) return c.t_ns;
+    return std::nullopt;
+  };
+  std::vector<std::pair<std::size_t, FeatureId>> eligible;  // (length, id)
+  for (const auto& [id, track] : tracks) {
+    if (!isObservedIn(track, clone_id)) continue;
+    const int length = static_cast<int>(track.observations.size());
+    bool ok = length >= rule.min_length;
+    if (!ok && length >= rule.span_min_length) {
+      const auto first = cloneTime(track.observations.front().clone_id), last = cloneTime(clone_id);
+      ok = first && last && *last - *first >= rule.min_span_ns;
+    }
+    if (ok) eligible.emplace_back(track.observations.size(), id);
+  }
   std::sort(eligible.begin(), eligible.end(),
             [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
   for (int k = 0; k < free_slots && k < static_cast<int>(eligible.size()); ++k)

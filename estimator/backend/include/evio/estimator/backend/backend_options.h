@@ -76,6 +76,11 @@ struct BackendOptions {
   double map_prior_max_relative_sigma = 0.25;
   int map_prior_min_points = 3;
   int slam_min_track_length = 10;          ///< observations before a track may become SLAM
+  /// Or a track of at least msckf_min_track_length observations spanning
+  /// this long, s (0: off): the time slam_min_track_length frames take at
+  /// 20 Hz, 0.45 s, which an event tracker's track of a slow feature spans
+  /// with fewer observations (docs/algorithms.md#slam-features).
+  double slam_min_track_span_s = 0.45;
   double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
   int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
@@ -273,6 +278,7 @@ struct BackendOptions {
       "a SLAM feature counts for the map's depth when its sigma_rho / rho is at most this");
     v("map_prior_min_points", map_prior_min_points, "points in front of the camera the map's depth needs");
     v("slam_min_track_length", slam_min_track_length, "observations before SLAM");
+    v("slam_min_track_span_s", slam_min_track_span_s, "or a track spanning this long, s (0: off)");
     v("slam_gate_probability", slam_gate_probability, "SLAM Mahalanobis gate probability");
     v("slam_max_gate_failures", slam_max_gate_failures, "gate failures removing a SLAM feature");
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");

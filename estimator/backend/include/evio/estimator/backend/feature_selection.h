@@ -57,6 +57,21 @@ void extendTracks(const std::vector<FeatureObservation>& observations, const Fil
 std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, std::int64_t clone_id, int free_slots,
                                             int min_length);
 
+/// Which tracks may become SLAM: `min_length` observations, or, when
+/// `min_span_ns` > 0, at least `span_min_length` observations whose first
+/// and newest clones (times from `state`) lie `min_span_ns` or more apart:
+/// an event tracker reports a slowly moving feature at few updates, so its
+/// track can span the time ten frames take with fewer observations.
+struct SlamEligibility {
+  int min_length = 10;
+  TimeNs min_span_ns = 0;
+  int span_min_length = 3;
+};
+
+/// chooseSlamCandidates with the span rule of `rule`.
+std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, const FilterState& state, std::int64_t clone_id,
+                                            int free_slots, const SlamEligibility& rule);
+
 struct MsckfChoice {
   std::vector<FeatureId> update;  ///< tracks to use as MSCKF features, in id order
   std::vector<FeatureId> erase;   ///< lost tracks (not seen in the newest clone), in id order

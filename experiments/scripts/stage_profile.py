@@ -40,7 +40,7 @@ def parse_sequence(text):
 
 def run(evio, config, folder, overrides, out):
     cmd = [evio, "estimate", folder, "--method", "eklt-vio", "--init", "groundtruth",
-           "--config", config, "-o", out, "-q", "--set", "frontend.threads=1"]
+           "--config", config, "-o", out, "-q", "--set", "frontend.threads=1", "--set", "backend_thread=false"]
     for o in overrides:
         cmd += ["--set", o]
     subprocess.run(cmd, check=True)

@@ -159,6 +159,14 @@ TEST(BackendSteps, SlamCandidatesBySpanNeedTheSpanAndThreeObservations) {
   // The count rule still applies beside the span rule.
   EXPECT_EQ(chooseSlamCandidates(tracks, state, 10, 5, SlamEligibility{2, secondsToNs(0.45), 3}),
             (std::vector<FeatureId>{1, 3, 2}));
+  // A track not observed in the newest clone is never a candidate, however
+  // long it spans; with fewer slots the longest tracks win, ties by id.
+  TrackMap more = tracks;
+  more.emplace(4, track(4, {6, 7, 8, 9}));              // lost: not in clone 10
+  more.emplace(5, track(5, {6, 7, 8, 9, 10}));          // five observations over 0.5 s
+  const SlamEligibility rule{.min_length = 10, .min_span_ns = secondsToNs(0.2), .span_min_length = 3};
+  EXPECT_EQ(chooseSlamCandidates(more, state, 10, 5, rule), (std::vector<FeatureId>{5, 1, 3}));
+  EXPECT_EQ(chooseSlamCandidates(more, state, 10, 2, rule), (std::vector<FeatureId>{5, 1}));
 }
 
 TEST(BackendSteps, MsckfTracksAreThoseLeavingTheWindowAndTheLostOnes) {

@@ -33,8 +33,9 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
                          static_cast<int>(slam_gate.gated_out.size());
   const std::vector<FeatureId> slam_candidates =
       chooseSlamCandidates(tracks_, state_, clone_id, free_slots,
-                           SlamEligibility{options_.slam_min_track_length, secondsToNs(options_.slam_min_track_span_s),
-                                           options_.msckf_min_track_length});
+                           SlamEligibility{.min_length = options_.slam_min_track_length,
+                                           .min_span_ns = secondsToNs(options_.slam_min_track_span_s),
+                                           .span_min_length = options_.msckf_min_track_length});
   const std::optional<std::size_t> leaving = cloneToMarginalize();
   const bool sliding = leaving == std::size_t{0};  // tracks losing their oldest observation go to the MSCKF
   const MsckfChoice msckf_choice = chooseMsckfTracks(

@@ -82,19 +82,23 @@ std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, const Filter
   if (rule.min_span_ns <= 0) return chooseSlamCandidates(tracks, clone_id, free_slots, rule.min_length);
   std::vector<FeatureId> out;
   if (free_slots <= 0) return out;
+  // Every observation's clone is in the window (marginalizeClone drops the
+  // observations of the clone it removes); a track whose clone is not found
+  // is not admitted by the span.
   const auto cloneTime = [&state](std::int64_t id) -> std::optional<TimeNs> {
     for (const auto& c : state.clones)
       if (c.id == id) return c.t_ns;
     return std::nullopt;
   };
+  const std::optional<TimeNs> newest = cloneTime(clone_id);
   std::vector<std::pair<std::size_t, FeatureId>> eligible;  // (length, id)
   for (const auto& [id, track] : tracks) {
     if (!isObservedIn(track, clone_id)) continue;
     const int length = static_cast<int>(track.observations.size());
     bool ok = length >= rule.min_length;
     if (!ok && length >= rule.span_min_length) {
-      const auto first = cloneTime(track.observations.front().clone_id), last = cloneTime(clone_id);
-      ok = first && last && *last - *first >= rule.min_span_ns;
+      const auto first = cloneTime(track.observations.front().clone_id);
+      ok = first && newest && *newest - *first >= rule.min_span_ns;
     }
     if (ok) eligible.emplace_back(track.observations.size(), id);
   }

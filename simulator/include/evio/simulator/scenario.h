@@ -180,6 +180,8 @@ struct RenderScheduleOptions {
   /// events depend slightly on it: a few rays' bits change with the ray
   /// streams, docs/simulation.md) and 8 px for "tiles" (fewer rays than 16 px
   /// where the rates differ within a tile; README "Simulation (issue 5)").
+  /// The loader replaces 0 by the tile in use, so a resolved scenario.yaml
+  /// states it (and keeps it if re-run with the other schedule).
   int tile_px = 0;
   double tile_quantum_s = 0.0;        ///< "tiles": due times on a grid of this period, s; 0 = 1 / max_rate_hz
   int supersampling = 1;              ///< n × n radiance rays per pixel

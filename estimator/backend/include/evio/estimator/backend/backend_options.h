@@ -77,9 +77,10 @@ struct BackendOptions {
   int map_prior_min_points = 3;
   int slam_min_track_length = 10;          ///< observations before a track may become SLAM
   /// Or a track of at least msckf_min_track_length observations spanning
-  /// this long, s (0: off): the time slam_min_track_length frames take at
-  /// 20 Hz, 0.45 s, which an event tracker's track of a slow feature spans
-  /// with fewer observations (docs/algorithms.md#slam-features).
+  /// this long, s (0: off): ten observations at 20 Hz frames span 0.45 s,
+  /// which an event tracker's track of a slow feature spans with fewer
+  /// observations (docs/algorithms.md#slam-features). The floor of three is
+  /// msckf_min_track_length: the shortest track the filter uses at all.
   double slam_min_track_span_s = 0.45;
   double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
   int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature

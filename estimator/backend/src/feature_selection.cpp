@@ -64,22 +64,12 @@ void extendTracks(const std::vector<FeatureObservation>& observations, const Fil
 
 std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, std::int64_t clone_id, int free_slots,
                                             int min_length) {
-  std::vector<FeatureId> out;
-  if (free_slots <= 0) return out;
-  std::vector<std::pair<std::size_t, FeatureId>> eligible;  // (length, id)
-  for (const auto& [id, track] : tracks)
-    if (isObservedIn(track, clone_id) && static_cast<int>(track.observations.size()) >= min_length)
-      eligible.emplace_back(track.observations.size(), id);
-  std::sort(eligible.begin(), eligible.end(),
-            [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
-  for (int k = 0; k < free_slots && k < static_cast<int>(eligible.size()); ++k)
-    out.push_back(eligible[static_cast<std::size_t>(k)].second);
-  return out;
+  return chooseSlamCandidates(tracks, FilterState{}, clone_id, free_slots,
+                              SlamEligibility{.min_length = min_length, .min_span_ns = 0});
 }
 
 std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, const FilterState& state, std::int64_t clone_id,
                                             int free_slots, const SlamEligibility& rule) {
-  if (rule.min_span_ns <= 0) return chooseSlamCandidates(tracks, clone_id, free_slots, rule.min_length);
   std::vector<FeatureId> out;
   if (free_slots <= 0) return out;
   // Every observation's clone is in the window (marginalizeClone drops the
@@ -90,18 +80,17 @@ std::vector<FeatureId> chooseSlamCandidates(const TrackMap& tracks, const Filter
       if (c.id == id) return c.t_ns;
     return std::nullopt;
   };
-  const std::optional<TimeNs> newest = cloneTime(clone_id);
+  const std::optional<TimeNs> newest = rule.min_span_ns > 0 ? cloneTime(clone_id) : std::nullopt;
+  const auto spansEnough = [&](const FeatureTrack& track) {
+    if (!newest || static_cast<int>(track.observations.size()) < rule.span_min_length) return false;
+    const std::optional<TimeNs> first = cloneTime(track.observations.front().clone_id);
+    return first && *newest - *first >= rule.min_span_ns;
+  };
   std::vector<std::pair<std::size_t, FeatureId>> eligible;  // (length, id)
-  for (const auto& [id, track] : tracks) {
-    if (!isObservedIn(track, clone_id)) continue;
-    const int length = static_cast<int>(track.observations.size());
-    bool ok = length >= rule.min_length;
-    if (!ok && length >= rule.span_min_length) {
-      const auto first = cloneTime(track.observations.front().clone_id);
-      ok = first && newest && *newest - *first >= rule.min_span_ns;
-    }
-    if (ok) eligible.emplace_back(track.observations.size(), id);
-  }
+  for (const auto& [id, track] : tracks)
+    if (isObservedIn(track, clone_id) &&
+        (static_cast<int>(track.observations.size()) >= rule.min_length || spansEnough(track)))
+      eligible.emplace_back(track.observations.size(), id);
   std::sort(eligible.begin(), eligible.end(),
             [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
   for (int k = 0; k < free_slots && k < static_cast<int>(eligible.size()); ++k)

@@ -131,7 +131,9 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   const CameraChoice cam = chooseCamera(folder, requested.tracker == "klt", images);
   const estimator::FrontendOptions options = estimator::resolveSensorParameters(requested, cam.event_parameters);
   ImuSamples imu;
-  if (options.tracker == "eklt" && options.eklt.imu_prediction) {
+  const bool gyro_prediction = (options.tracker == "eklt" && options.eklt.imu_prediction) ||
+                               (options.tracker == "klt" && options.klt.imu_prediction);
+  if (gyro_prediction) {
     imu = io::readImuText((fs::path(folder) / "imu.txt").string());
     if (!cam.T_B_C) throw Error(folder + ": imu_prediction needs T_B_C from sensors.yaml");
   }

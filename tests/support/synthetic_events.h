@@ -118,8 +118,9 @@ cv::Mat renderLog(const BlobTexture& tex, const Motion& m, double t, int width, 
   return out;
 }
 
-/// An 8-bit frame I = 255 · (exp(L) − 0.01), saturating.
-inline cv::Mat render8(const BlobTexture& tex, const RigidMotion& m, double t, int width, int height) {
+/// An 8-bit frame I = 255 · (exp(L) − 0.01), saturating. `Motion` as for renderLog.
+template <class Motion>
+cv::Mat render8(const BlobTexture& tex, const Motion& m, double t, int width, int height) {
   cv::Mat out(height, width, CV_8UC1);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {

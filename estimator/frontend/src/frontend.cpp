@@ -49,7 +49,7 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
   else if (options_.tracker == "haste")
     tracker_ = std::make_unique<HasteTracker>(options_.haste, camera, options_.threads);
   else
-    tracker_ = std::make_unique<KltTracker>(options_.klt, camera);
+    tracker_ = std::make_unique<KltTracker>(options_.klt, camera, T_B_C);
   if (options_.image_source == "reconstructed")
     reconstructor_ = std::make_unique<ImageReconstructor>(options_.reconstruction, camera.width(), camera.height());
   if (options_.track_lag.estimate && options_.tracker != "klt")

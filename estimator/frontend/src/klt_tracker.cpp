@@ -24,8 +24,31 @@ void KltOptions::validate() const {
   requireField(ransac_confidence > 0.0 && ransac_confidence < 1.0, "ransac_confidence", "must be in (0, 1)");
 }
 
-KltTracker::KltTracker(const KltOptions& options, const Camera& camera) : options_(options), camera_(camera) {
+KltTracker::KltTracker(const KltOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
+    : options_(options), camera_(camera) {
   options_.validate();
+  if (options_.imu_prediction) {
+    require(T_B_C.has_value(), "KltTracker: imu_prediction needs T_B_C");
+    predictor_ = std::make_unique<GyroPredictor>(camera_, *T_B_C);
+  }
+}
+
+void KltTracker::addImu(const ImuSample& sample) {
+  if (predictor_) predictor_->addImu(sample);
+}
+
+std::vector<cv::Point2f> KltTracker::searchStarts(TimeNs t_ns) const {
+  std::vector<cv::Point2f> starts;
+  starts.reserve(points_.size());
+  for (const Vec2& p : points_) {
+    // A feature predicted outside the image starts there too: Lucas–Kanade
+    // loses it, instead of searching from its old place and finding another.
+    Vec2 start = p;
+    if (predictor_ && !predictor_->empty())
+      if (const std::optional<Vec2> uv = predictor_->predict(p, previous_t_ns_, t_ns)) start = *uv;
+    starts.emplace_back(static_cast<float>(start.x()), static_cast<float>(start.y()));
+  }
+  return starts;
 }
 
 void KltTracker::drainTrackPoints(TrackPoints& out) {
@@ -40,14 +63,17 @@ void KltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
 
   // 1. Track the live features into this frame.
   if (!points_.empty() && !previous_.empty()) {
-    std::vector<cv::Point2f> p0, p1;
+    std::vector<cv::Point2f> p0;
     for (const Vec2& p : points_) p0.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+    // Without a prediction p1 starts at p0, as OpenCV does by itself.
+    std::vector<cv::Point2f> p1 = predictor_ ? searchStarts(t_ns) : p0;
     std::vector<std::uint8_t> status;
     std::vector<float> err;
     cv::calcOpticalFlowPyrLK(previous_, image8, p0, p1, status, err, cv::Size(options_.window_px, options_.window_px),
                              options_.pyramid_levels - 1,
                              cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.max_iterations,
-                                              options_.lk_epsilon));
+                                              options_.lk_epsilon),
+                             predictor_ ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
     std::vector<bool> keep(points_.size(), false);
     std::vector<std::size_t> candidates;
     for (std::size_t k = 0; k < points_.size(); ++k) {

@@ -75,7 +75,7 @@ FrontendOptions resolveSensorParameters(FrontendOptions options,
 class Frontend {
  public:
   /// `camera` is the event camera (EKLT, HASTE) or frame camera (KLT); `T_B_C` is
-  /// needed for the EKLT gyro prediction only.
+  /// needed for a gyro prediction only (eklt.imu_prediction, klt.imu_prediction).
   Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
   ~Frontend();
 

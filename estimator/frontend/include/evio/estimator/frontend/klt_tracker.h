@@ -8,12 +8,23 @@
 /// normalised coordinates and scaled by fx before RANSAC, so the threshold
 /// means the same whatever the distortion. Track points are emitted at frame
 /// times; events are ignored.
+///
+/// With `imu_prediction` each live feature's search starts where the gyro's
+/// rotation since the previous frame moves it (gyro_predictor.h: the
+/// feature taken as infinitely far, the bias not removed), not where it was:
+/// Lucas–Kanade then only has to find the translation's parallax and the
+/// prediction's error, which keeps tracks through rotations whose image
+/// motion between frames is more than the pyramid covers.
 
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "evio/core/camera/camera.h"
 #include "evio/core/options.h"
+#include "evio/core/pose.h"
 #include "evio/estimator/frontend/feature_tracker.h"
+#include "evio/estimator/frontend/gyro_predictor.h"
 
 namespace evio::estimator {
 
@@ -31,6 +42,7 @@ struct KltOptions {
   bool ransac = true;                ///< fundamental-matrix RANSAC
   double ransac_threshold_px = 0.6;  ///< epipolar distance, px of the undistorted image
   double ransac_confidence = 0.99;   ///< RANSAC confidence
+  bool imu_prediction = false;       ///< start each search at the gyro's prediction (needs IMU and T_B_C)
 
   template <class V>
   void fields(V& v) {
@@ -47,18 +59,21 @@ struct KltOptions {
     v("ransac", ransac, "fundamental-matrix RANSAC");
     v("ransac_threshold_px", ransac_threshold_px, "RANSAC threshold, px of the undistorted image");
     v("ransac_confidence", ransac_confidence, "RANSAC confidence");
+    v("imu_prediction", imu_prediction, "start each Lucas-Kanade search at the gyro's prediction");
   }
   void validate() const;
 };
 
 class KltTracker final : public FeatureTracker {
  public:
-  KltTracker(const KltOptions& options, const Camera& camera);
+  /// `T_B_C` (camera into body frame) is needed with `imu_prediction` only.
+  KltTracker(const KltOptions& options, const Camera& camera, std::optional<Pose> T_B_C = std::nullopt);
 
   void addFrame(TimeNs t_ns, const cv::Mat& image) override;
   using FeatureTracker::addEvents;
   void addEvents(const EventArray&, std::size_t, std::size_t) override {}
-  void addImu(const ImuSample&) override {}
+  void addImu(const ImuSample& sample) override;
+  bool usesImu() const override { return predictor_ != nullptr; }
   void drainTrackPoints(TrackPoints& out) override;
   std::size_t numAlive() const override { return ids_.size(); }
   std::string_view name() const override { return "klt"; }
@@ -72,6 +87,10 @@ class KltTracker final : public FeatureTracker {
   std::vector<Vec2> points_;
   FeatureId next_id_ = 0;
   TrackPoints out_;
+  std::unique_ptr<GyroPredictor> predictor_;  ///< with imu_prediction
+
+  /// Where each live feature's search starts in the frame at t_ns.
+  std::vector<cv::Point2f> searchStarts(TimeNs t_ns) const;
 };
 
 }  // namespace evio::estimator

@@ -79,6 +79,7 @@ struct CameraChoice {
   std::optional<Pose> T_B_C;
   std::string name;
   std::map<std::string, double> event_parameters;  ///< the event camera's stated parameters (sensors.yaml)
+  TimeNs time_offset_cam_imu_ns = 0;                ///< t_imu = t_cam + offset (sensors.yaml)
 };
 
 CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
@@ -95,7 +96,8 @@ CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
     if (pick == nullptr) pick = &rig.cameras.front();
     const CameraSensor* event = rig.firstCamera(CameraRole::kEvent);
     return CameraChoice{pick->camera, pick->T_B_C, pick->name,
-                        event != nullptr ? event->parameters : std::map<std::string, double>{}};
+                        event != nullptr ? event->parameters : std::map<std::string, double>{},
+                        rig.time_offset_cam_imu_ns};
   }
   const fs::path calib = fs::path(folder) / "calib.txt";
   if (!fs::exists(calib)) throw Error(folder + ": neither sensors.yaml nor calib.txt");
@@ -135,6 +137,8 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
                                (options.tracker == "klt" && options.klt.imu_prediction);
   if (gyro_prediction) {
     imu = io::readImuText((fs::path(folder) / "imu.txt").string());
+    // On the camera clock, as the pipeline feeds the frontend: t_cam = t_imu − offset.
+    for (ImuSample& sample : imu) sample.t_ns -= cam.time_offset_cam_imu_ns;
     if (!cam.T_B_C) throw Error(folder + ": imu_prediction needs T_B_C from sensors.yaml");
   }
 

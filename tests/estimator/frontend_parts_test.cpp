@@ -200,6 +200,19 @@ TEST(GyroPredictor, IntegratesConstantRateAndPredictsRotatedProjection) {
   EXPECT_GT((*uv1 - uv0).norm(), 10.0);  // it did move
 }
 
+// The frontend hands its T_B_C to the KLT tracker when klt.imu_prediction
+// asks for the gyro: without one it is an error, with one the tracker takes
+// the IMU (and the pipeline must feed it between frames).
+TEST(Frontend, KltGyroPredictionTakesTheExtrinsicsAndTheImu) {
+  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+  FrontendOptions options;
+  options.tracker = "klt";
+  EXPECT_FALSE(Frontend(options, cam).tracker().usesImu());
+  options.klt.imu_prediction = true;
+  EXPECT_THROW(Frontend(options, cam), Error);
+  EXPECT_TRUE(Frontend(options, cam, Pose()).tracker().usesImu());
+}
+
 TEST(FrontendOptions, DefaultsRoundTripThroughYamlAndOverridesAreChecked) {
   const FrontendOptions defaults;
   FrontendOptions back;

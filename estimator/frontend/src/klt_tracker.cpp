@@ -43,6 +43,8 @@ std::vector<cv::Point2f> KltTracker::searchStarts(TimeNs t_ns) const {
   for (const Vec2& p : points_) {
     // A feature predicted outside the image starts there too: Lucas–Kanade
     // loses it, instead of searching from its old place and finding another.
+    // Only where no prediction exists (a bearing the camera model cannot
+    // project) does the search start from the old place.
     Vec2 start = p;
     if (predictor_ && !predictor_->empty())
       if (const std::optional<Vec2> uv = predictor_->predict(p, previous_t_ns_, t_ns)) start = *uv;

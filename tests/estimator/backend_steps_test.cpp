@@ -337,6 +337,53 @@ TEST(BackendUpdaters, SlamGateAcceptsThePredictionAndGatesOutRepeatedOutliers) {
   EXPECT_EQ(b.stats.slam_features_removed, 1);
 }
 
+TEST(BackendUpdaters, SlamUpdateIntervalLeavesOutObservationsTooSoonAfterTheLastUpdate) {
+  // One feature, initialised at clone 0 (t = 0), observed exactly in clones
+  // at 10, 30, 50, 60 and 90 ms. With a 40 ms interval only the observations
+  // at 50 ms (40 ms after the initialisation) and 90 ms (40 ms after that
+  // update) enter; the others are neither accepted nor counted as rejected.
+  UpdaterBench b(cloneRow({0.0, 0.0, 0.0, 0.0, 0.0, 0.0}));
+  const std::vector<double> t_s{0.0, 0.010, 0.030, 0.050, 0.060, 0.090};
+  for (std::size_t i = 0; i < t_s.size(); ++i) b.state.clones[i].t_ns = secondsToNs(t_s[i]);
+  SlamFeature f;
+  f.id = 9;
+  f.anchor_clone_id = 0;
+  f.abr = Vec3(0.1, -0.2, 0.5);
+  f.last_update_ns = 0;
+  b.state.features.push_back(f);
+  b.state.P = 1e-4 * MatX::Identity(b.state.dim(), b.state.dim());
+  const std::vector<FeatureObservation> seen{{9, Vec2(0.1, -0.2)}};
+  const auto accepted_at = [&](double interval_s) {
+    b.options.slam_update_interval_s = interval_s;
+    b.state.features[0].last_update_ns = 0;
+    SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+    std::vector<double> at;
+    for (std::size_t c = 1; c < t_s.size(); ++c) {
+      const SlamGate g = slam.gate(seen, c);
+      EXPECT_TRUE(g.gated_out.empty());
+      if (!g.accepted.empty()) at.push_back(t_s[c]);
+    }
+    return at;
+  };
+  EXPECT_EQ(accepted_at(0.0), (std::vector<double>{0.010, 0.030, 0.050, 0.060, 0.090}));
+  EXPECT_EQ(accepted_at(0.04), (std::vector<double>{0.050, 0.090}));
+  EXPECT_EQ(b.state.features[0].last_update_ns, secondsToNs(0.090));
+  EXPECT_EQ(b.stats.slam_updates_rejected, 0);
+  EXPECT_EQ(b.state.features[0].gate_failures, 0);
+}
+
+TEST(BackendUpdaters, ANewSlamFeatureCountsItsInitialisationAsItsLastUpdate) {
+  UpdaterBench b(cloneRow({0.0, 0.0}));
+  b.state.clones[0].t_ns = secondsToNs(1.0);
+  b.state.clones[1].t_ns = secondsToNs(1.25);
+  b.options.slam_min_depth_m = 0.5;
+  SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+  TrackMap tracks{{3, track(3, {0, 1})}};
+  ASSERT_TRUE(slam.initialize({3}, &tracks));
+  ASSERT_EQ(b.state.features.size(), 1u);
+  EXPECT_EQ(b.state.features[0].last_update_ns, secondsToNs(1.25));  // the track's last clone, where it enters
+}
+
 TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheDepthPrior) {
   // Two clones at one pose: no parallax, so the track enters with ρ0 = 1/(2 d_min), σ = 1/(4 d_min).
   UpdaterBench b(cloneRow({0.0, 0.0}));

@@ -40,6 +40,11 @@ void SlamUpdater::diffuseSceneDepth(double dt_s) {
   state().P(s, s) += options().slam_scene_depth_share * sigma0 * sigma0 * dt_s / options().slam_scene_depth_memory_s;
 }
 
+bool SlamUpdater::dueForUpdate(const SlamFeature& f, TimeNs t_ns) const {
+  return options().slam_update_interval_s <= 0.0 ||
+         nsToSeconds(t_ns - f.last_update_ns) >= options().slam_update_interval_s - 1e-9;
+}
+
 void SlamUpdater::marginalizeUnobserved(const std::vector<FeatureObservation>& observations) {
   std::unordered_set<FeatureId> observed;
   for (const FeatureObservation& o : observations) observed.insert(o.id);
@@ -55,6 +60,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     const int j = state().findFeature(o.id);
     if (j < 0) continue;
     const auto jj = static_cast<std::size_t>(j);
+    if (!dueForUpdate(state().features[jj], state().clones[c].t_ns)) continue;
     Eigen::Matrix<double, 2, Eigen::Dynamic> H;
     Vec2 r;
     MatX Hc;
@@ -76,6 +82,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
       continue;
     }
     f.gate_failures = 0;
+    f.last_update_ns = state().clones[c].t_ns;
     out.accepted.push_back(obs);  // the update whitens with the same W as the gate
   }
   return out;
@@ -113,6 +120,7 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
     if (it == tracks->end() || it->second.observations.empty()) continue;
     const FeatureTrack& track = it->second;  // initialising touches the state, not the tracks
     const DepthPrior prior = depthPrior(c, track.observations.back().z);
+    const std::size_t features_before = state().features.size();
     bool done = false;
     if (options().slam_triangulated_init && !initializeTriangulated(track, prior.sigma, &done)) {
       tracks->erase(it);
@@ -130,6 +138,8 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
       }
       if (with_track == PriorWithTrack::kNotUsed) initializeWithPrior(track, c, prior);
     }
+    // Every initialisation takes the track's observation in clone c (its last).
+    if (state().features.size() > features_before) state().features.back().last_update_ns = state().clones[c].t_ns;
     tracks->erase(it);  // the track is a SLAM feature now, or failed its gate
   }
   return true;

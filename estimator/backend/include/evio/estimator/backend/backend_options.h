@@ -84,6 +84,14 @@ struct BackendOptions {
   double slam_min_track_span_s = 0.45;
   double slam_gate_probability = 0.95;     ///< Mahalanobis (χ², 2 dof) gate of SLAM updates
   int slam_max_gate_failures = 3;          ///< consecutive gate failures that remove a SLAM feature
+  /// A SLAM feature's observation enters the update only when at least this
+  /// long has passed since its last one did (or since it was initialised),
+  /// s (0: every measurement set, the default). An event tracker gives a
+  /// feature a position at every set (100–300 Hz), and its errors at 10 ms
+  /// apart are one error (correlation 0.8–0.9, README "Consistency"); the
+  /// skipped observations keep the feature alive but add no rows
+  /// (docs/algorithms.md#slam-features).
+  double slam_update_interval_s = 0.0;
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// A feature that takes a depth prior (fixed, map or range) takes it
   /// together with its track's observations in the window: the MAP (α, β, ρ)
@@ -282,6 +290,8 @@ struct BackendOptions {
     v("slam_min_track_span_s", slam_min_track_span_s, "or a track spanning this long, s (0: off)");
     v("slam_gate_probability", slam_gate_probability, "SLAM Mahalanobis gate probability");
     v("slam_max_gate_failures", slam_max_gate_failures, "gate failures removing a SLAM feature");
+    v("slam_update_interval_s", slam_update_interval_s,
+      "least time between two updates of one SLAM feature, s (0: every measurement set)");
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
     v("slam_prior_init_with_track", slam_prior_init_with_track,
       "a depth-prior SLAM initialisation also uses the track's observations in the window");

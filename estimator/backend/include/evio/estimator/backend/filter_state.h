@@ -62,6 +62,9 @@ struct SlamFeature {
   /// (only with track-error states: FilterState::feature_dim = 5).
   Vec2 track_error = Vec2::Zero();
   int gate_failures = 0;    ///< consecutive Mahalanobis gate failures
+  /// Time of the clone whose observation last entered an update or the
+  /// initialisation (BackendOptions::slam_update_interval_s), ns.
+  TimeNs last_update_ns = 0;
 };
 
 /// Sizes of the error-state blocks.

@@ -47,6 +47,8 @@ class SlamUpdater : public Updater {
   void marginalizeUnobserved(const std::vector<FeatureObservation>& observations);
   /// The observations of SLAM features in clone c (position), each gated with
   /// 2 dof; a feature failing slam_max_gate_failures times in a row is gated out.
+  /// With slam_update_interval_s, an observation of a feature updated less
+  /// than that long before is left out (neither accepted nor gated).
   SlamGate gate(const std::vector<FeatureObservation>& observations, std::size_t c);
   /// Rows of `accepted` at the linearisation point x (the iterated update
   /// calls it once per iteration), constrained; a feature missing from x or
@@ -106,6 +108,8 @@ class SlamUpdater : public Updater {
   /// is none or the ray does not meet the level plane in front of the camera.
   std::optional<double> rangeDepthPrior(const CameraClone& clone, const Vec2& z) const;
   void removeFeature(std::size_t j);
+  /// The feature's observation at t_ns may enter the update (slam_update_interval_s).
+  bool dueForUpdate(const SlamFeature& f, TimeNs t_ns) const;
 
   Camera camera_;
   double sigma_z_;

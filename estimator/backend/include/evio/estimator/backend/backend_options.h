@@ -87,10 +87,10 @@ struct BackendOptions {
   /// A SLAM feature's observation enters the update only when at least this
   /// long has passed since its last one did (or since it was initialised),
   /// s (0: every measurement set, the default). An event tracker gives a
-  /// feature a position at every set (100–300 Hz), and its errors at 10 ms
-  /// apart are one error (correlation 0.8–0.9, README "Consistency"); the
-  /// skipped observations keep the feature alive but add no rows
-  /// (docs/algorithms.md#slam-features).
+  /// feature a position at every set (up to about 300 Hz), and its errors 10 ms
+  /// apart are one error (correlation 0.8–0.9, README "Consistency from a
+  /// drawn initial error"); the skipped observations keep the feature alive
+  /// but add no rows (docs/algorithms.md#correlated-measurements).
   double slam_update_interval_s = 0.0;
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// A feature that takes a depth prior (fixed, map or range) takes it

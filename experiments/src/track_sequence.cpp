@@ -120,6 +120,17 @@ CameraChoice chooseCamera(const std::string& folder, bool frame_camera,
                       "calib.txt" + size_from, {}};  // calib.txt states no thresholds
 }
 
+/// The frontend for the folder's camera; its errors name the folder (e.g. a
+/// gyro prediction without T_B_C, which only sensors.yaml gives).
+estimator::Frontend frontendFor(const std::string& folder, const estimator::FrontendOptions& options,
+                                const CameraChoice& cam) {
+  try {
+    return estimator::Frontend(options, cam.camera, cam.T_B_C);
+  } catch (const Error& e) {
+    throw Error(folder + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& requested,
@@ -132,17 +143,13 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
     throw Error(folder + ": no frames (images.txt); use image_source reconstructed");
   const CameraChoice cam = chooseCamera(folder, requested.tracker == "klt", images);
   const estimator::FrontendOptions options = estimator::resolveSensorParameters(requested, cam.event_parameters);
+  estimator::Frontend frontend = frontendFor(folder, options, cam);
   ImuSamples imu;
-  const bool gyro_prediction = (options.tracker == "eklt" && options.eklt.imu_prediction) ||
-                               (options.tracker == "klt" && options.klt.imu_prediction);
-  if (gyro_prediction) {
+  if (frontend.usesImu()) {  // a gyro prediction
     imu = io::readImuText((fs::path(folder) / "imu.txt").string());
     // On the camera clock, as the pipeline feeds the frontend: t_cam = t_imu − offset.
     for (ImuSample& sample : imu) sample.t_ns -= cam.time_offset_cam_imu_ns;
-    if (!cam.T_B_C) throw Error(folder + ": imu_prediction needs T_B_C from sensors.yaml");
   }
-
-  estimator::Frontend frontend(options, cam.camera, cam.T_B_C);
   // The pre-filters run before the tracker, as in the pipeline's PrefilterStage.
   std::unique_ptr<estimator::EventPrefilter> prefilter;
   if (!options.prefilter.passThrough())

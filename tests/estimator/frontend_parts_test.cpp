@@ -208,9 +208,11 @@ TEST(Frontend, KltGyroPredictionTakesTheExtrinsicsAndTheImu) {
   FrontendOptions options;
   options.tracker = "klt";
   EXPECT_FALSE(Frontend(options, cam).tracker().usesImu());
+  EXPECT_FALSE(Frontend(options, cam).usesImu());
   options.klt.imu_prediction = true;
   EXPECT_THROW(Frontend(options, cam), Error);
   EXPECT_TRUE(Frontend(options, cam, Pose()).tracker().usesImu());
+  EXPECT_TRUE(Frontend(options, cam, Pose()).usesImu());  // evio track reads the IMU then
 }
 
 TEST(FrontendOptions, DefaultsRoundTripThroughYamlAndOverridesAreChecked) {

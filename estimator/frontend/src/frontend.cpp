@@ -77,7 +77,9 @@ void Frontend::addEvents(const EventArray& events) {
   }
 }
 
-bool Frontend::tracksEventChunks() const { return !reconstructor_ && !tracker_->usesImu(); }
+bool Frontend::tracksEventChunks() const { return !reconstructor_ && !usesImu(); }
+
+bool Frontend::usesImu() const { return tracker_->usesImu(); }
 
 void Frontend::addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,
                               std::vector<std::size_t>& point_ends) {

@@ -93,6 +93,9 @@ class Frontend {
   /// nothing but events changes the tracker between them (no reconstruction;
   /// a tracker that does not use the IMU, FeatureTracker::usesImu).
   bool tracksEventChunks() const;
+  /// True when the tracker takes the IMU (a gyro prediction,
+  /// FeatureTracker::usesImu): addImu then matters.
+  bool usesImu() const;
   /// The chunks [0, e0), [e0, e1), … of `events` (FeatureTracker::addEventChunks):
   /// the same as addEvents and drainTrackPoints chunk by chunk.
   void addEventChunks(const EventArray& events, const std::vector<std::size_t>& chunk_ends, TrackPoints& out,

@@ -83,6 +83,13 @@ std::string absolute(const std::string& dir, const std::string& path) {
   return fs::weakly_canonical(fs::path(dir) / path).string();
 }
 
+/// The file a key names (relative to the campaign's folder), which must exist.
+std::string existingFile(const Document& doc, const YAML::Node& node, const std::string& dir, const std::string& path) {
+  const std::string file = absolute(dir, scalarAs<std::string>(doc, node, path));
+  if (!fs::is_regular_file(file)) throwAt(doc, node, path, "no such file: " + file);
+  return file;
+}
+
 CampaignStep step(const Document& doc, const YAML::Node& steps, const char* key, std::vector<std::string> fallback) {
   CampaignStep s;
   s.command = std::move(fallback);
@@ -171,7 +178,7 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
     for (std::size_t i = 0; i < scenarios.size(); ++i) {
       const std::string p = "scenarios[" + std::to_string(i) + "]";
       const YAML::Node s = scenarios[i];
-      checkKeys(doc, s, p, {"name", "file", "sequence", "set", "estimate_set"});
+      checkKeys(doc, s, p, {"name", "file", "sequence", "set", "estimate_set", "estimator_config"});
       CampaignScenario sc;
       sc.name = name(doc, s["name"], p + ".name");
       if (!names.insert(sc.name).second) throwAt(doc, s["name"], p + ".name", "duplicate scenario name");
@@ -185,6 +192,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
       }
       if (const YAML::Node set = optional(s, "estimate_set"); set.IsDefined())
         flattenOverrides(doc, set, p + ".estimate_set", "", sc.estimate_set);
+      if (const YAML::Node ec = optional(s, "estimator_config"); ec.IsDefined())
+        sc.estimator_config = existingFile(doc, ec, c.dir, p + ".estimator_config");
       c.scenarios.push_back(sc);
     }
 
@@ -232,11 +241,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
     }
     if (const YAML::Node cache = optional(root, "cache"); cache.IsDefined())
       c.cache = absolute(c.dir, scalarAs<std::string>(doc, cache, "cache"));
-    if (const YAML::Node ec = optional(root, "estimator_config"); ec.IsDefined()) {
-      c.estimator_config = absolute(c.dir, scalarAs<std::string>(doc, ec, "estimator_config"));
-      if (!fs::is_regular_file(c.estimator_config))
-        throwAt(doc, ec, "estimator_config", "no such file: " + c.estimator_config);
-    }
+    if (const YAML::Node ec = optional(root, "estimator_config"); ec.IsDefined())
+      c.estimator_config = existingFile(doc, ec, c.dir, "estimator_config");
 
     YAML::Node steps = optional(root, "steps");
     if (steps.IsDefined()) checkKeys(doc, steps, "steps", {"simulate", "estimate", "evaluate"});
@@ -314,11 +320,17 @@ std::vector<Job> expandJobs(const Campaign& c) {
             (axis.step == "simulate" ? j.simulate_set : axis.step == "estimate" ? j.estimate_set : j.evaluate_set)
                 .push_back(kv);
           }
+          const std::string& own_config = c.scenarios[s].estimator_config;
+          j.estimator_config = own_config.empty() ? c.estimator_config : own_config;
           const std::string& sc = c.scenarios[s].name;
-          const std::string identity = "scenario=" + sc + "|method=" + c.methods[m].name +
-                                       "|seed=" + std::to_string(seed) + "|simulate=" + overridesText(j.simulate_set) +
-                                       "|estimate=" + overridesText(j.estimate_set) +
-                                       "|evaluate=" + overridesText(j.evaluate_set);
+          // The estimator configuration is part of the identity by file name
+          // (ids do not depend on where the checkout is): another parameter
+          // set is another job, not one a resumed campaign would skip.
+          const std::string identity =
+              "scenario=" + sc + "|method=" + c.methods[m].name + "|seed=" + std::to_string(seed) +
+              "|simulate=" + overridesText(j.simulate_set) + "|estimate=" + overridesText(j.estimate_set) +
+              "|evaluate=" + overridesText(j.evaluate_set) +
+              (j.estimator_config.empty() ? "" : "|estimator_config=" + fs::path(j.estimator_config).filename().string());
           char hash[24];
           std::snprintf(hash, sizeof(hash), "%08llx",
                         static_cast<unsigned long long>(fnv1a64(identity) & 0xffffffffull));

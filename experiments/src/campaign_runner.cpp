@@ -120,6 +120,7 @@ std::string jobYaml(const Campaign& c, const Job& job, const std::string& sequen
   out << YAML::Key << "simulate_set" << YAML::Value << YAML::DoubleQuoted << overridesText(job.simulate_set);
   out << YAML::Key << "estimate_set" << YAML::Value << YAML::DoubleQuoted << overridesText(job.estimate_set);
   out << YAML::Key << "evaluate_set" << YAML::Value << YAML::DoubleQuoted << overridesText(job.evaluate_set);
+  out << YAML::Key << "estimator_config" << YAML::Value << job.estimator_config;
   out << YAML::Key << "sequence" << YAML::Value << sequence;
   out << YAML::Key << "status" << YAML::Value << outcome.status;
   out << YAML::Key << "cause" << YAML::Value << YAML::DoubleQuoted << outcome.cause;
@@ -194,7 +195,7 @@ std::string ensureSequence(const Campaign& c, const Job& job, const RunnerOption
 }
 
 /// A finished job of the same scenario file, method, seed, simulate and
-/// estimate settings whose estimate step succeeded: its estimate is this
+/// estimate settings and estimator configuration whose estimate step succeeded: its estimate is this
 /// job's too (only the evaluation differs). Returns its folder or "".
 fs::path estimateDonor(const fs::path& results, const Job& job, const std::string& method,
                        const std::string& scenario, const std::string& sequence) {
@@ -215,6 +216,7 @@ fs::path estimateDonor(const fs::path& results, const Job& job, const std::strin
       const YAML::Node y = YAML::LoadFile((dir / "job.yaml").string());
       if (y["simulate_set"].as<std::string>("") != overridesText(job.simulate_set) ||
           y["estimate_set"].as<std::string>("") != overridesText(job.estimate_set) ||
+          y["estimator_config"].as<std::string>("") != job.estimator_config ||
           y["sequence"].as<std::string>("") != sequence)
         continue;
       for (const auto& step : y["steps"])
@@ -375,7 +377,7 @@ std::vector<std::string> expandCommand(const Campaign& c, const CampaignStep& st
     else if (arg == "{estimate_set}") sets(job.estimate_set);
     else if (arg == "{evaluate_set}") sets(job.evaluate_set);
     else if (arg == "{estimator_config}") {
-      if (!c.estimator_config.empty()) out.insert(out.end(), {"--config", c.estimator_config});
+      if (!job.estimator_config.empty()) out.insert(out.end(), {"--config", job.estimator_config});
     } else if (arg == "{method_option}") {
       const bool sets_method = std::any_of(job.estimate_set.begin(), job.estimate_set.end(),
                                            [](const auto& kv) { return kv.first == "method"; });

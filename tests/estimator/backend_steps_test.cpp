@@ -372,6 +372,46 @@ TEST(BackendUpdaters, SlamUpdateIntervalLeavesOutObservationsTooSoonAfterTheLast
   EXPECT_EQ(b.state.features[0].gate_failures, 0);
 }
 
+TEST(BackendUpdaters, SlamUpdateDisplacementLetsInObservationsOfAFeatureThatHasMoved) {
+  // The feature initialised at t = 0 at z0 = (0.1, −0.2), observed at 10, 30,
+  // 50, 60 and 90 ms displaced along x from z0 by 0.006, 0.007, 0.008, 0.014
+  // and 0.015 (all inside the gate: σ 0.01). With a least displacement of
+  // 0.005 an observation enters when it lies 0.005 or more from the one of
+  // the last update: 10 ms (0.006 from z0) and 60 ms (0.006 from 10 ms's);
+  // with a 40 ms interval as well, either lets it in: 50 ms too (40 ms
+  // after 10 ms's update), and 90 ms is 30 ms and 0.001 after 60 ms's.
+  UpdaterBench b(cloneRow({0.0, 0.0, 0.0, 0.0, 0.0, 0.0}));
+  const std::vector<double> t_s{0.0, 0.010, 0.030, 0.050, 0.060, 0.090};
+  const std::vector<double> dx{0.0, 0.006, 0.007, 0.008, 0.014, 0.015};
+  for (std::size_t i = 0; i < t_s.size(); ++i) b.state.clones[i].t_ns = secondsToNs(t_s[i]);
+  const Vec2 z0(0.1, -0.2);
+  SlamFeature f;
+  f.id = 9;
+  f.anchor_clone_id = 0;
+  f.abr = Vec3(z0.x(), z0.y(), 0.5);
+  b.state.features.push_back(f);
+  b.state.P = 1e-4 * MatX::Identity(b.state.dim(), b.state.dim());
+  const auto accepted_at = [&](double interval_s, double displacement) {
+    b.options.slam_update_interval_s = interval_s;
+    b.options.slam_update_min_displacement_normalized = displacement;
+    b.state.features[0].last_update_ns = 0;
+    b.state.features[0].last_update_z = z0;
+    SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+    std::vector<double> at;
+    for (std::size_t c = 1; c < t_s.size(); ++c) {
+      const SlamGate g = slam.gate({{9, z0 + Vec2(dx[c], 0.0)}}, c);
+      EXPECT_TRUE(g.gated_out.empty());
+      if (!g.accepted.empty()) at.push_back(t_s[c]);
+    }
+    return at;
+  };
+  EXPECT_EQ(accepted_at(0.0, 0.005), (std::vector<double>{0.010, 0.060}));
+  EXPECT_TRUE(b.state.features[0].last_update_z.isApprox(z0 + Vec2(0.014, 0.0)));
+  EXPECT_EQ(accepted_at(0.04, 0.005), (std::vector<double>{0.010, 0.050, 0.060}));
+  EXPECT_EQ(accepted_at(0.04, 0.0), (std::vector<double>{0.050, 0.090}));
+  EXPECT_EQ(b.stats.slam_updates_rejected, 0);
+}
+
 TEST(BackendUpdaters, ANewSlamFeatureCountsItsInitialisationAsItsLastUpdate) {
   UpdaterBench b(cloneRow({0.0, 0.0}));
   b.state.clones[0].t_ns = secondsToNs(1.0);
@@ -379,9 +419,11 @@ TEST(BackendUpdaters, ANewSlamFeatureCountsItsInitialisationAsItsLastUpdate) {
   b.options.slam_min_depth_m = 0.5;
   SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
   TrackMap tracks{{3, track(3, {0, 1})}};
+  tracks[3].observations.back().z = Vec2(0.2, 0.1);
   ASSERT_TRUE(slam.initialize({3}, &tracks));
   ASSERT_EQ(b.state.features.size(), 1u);
   EXPECT_EQ(b.state.features[0].last_update_ns, secondsToNs(1.25));  // the track's last clone, where it enters
+  EXPECT_EQ(b.state.features[0].last_update_z, Vec2(0.2, 0.1));     // and its observation there
 }
 
 TEST(BackendUpdaters, SlamInitialisationWithoutParallaxTakesTheDepthPrior) {

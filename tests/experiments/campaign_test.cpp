@@ -261,6 +261,64 @@ steps:
   EXPECT_NE(e.find("bad.yaml:5: estimator_config"), std::string::npos) << e;
 }
 
+TEST(CampaignRunner, AScenarioMayNameItsOwnEstimatorConfig) {
+  // One parameter set per rig: a scenario's estimator_config replaces the
+  // campaign's for that scenario's jobs only; the configuration's file name
+  // is part of a job's identity.
+  test::TempDir dir;
+  fs::create_directories(dir.file("tuning"));
+  io::writeFileAtomic(dir.file("tuning/indoor.yaml"), "sync: {n_e: 3200}\n");
+  io::writeFileAtomic(dir.file("tuning/mars.yaml"), "backend: {slam_update_interval_s: 0.04}\n");
+  const std::string head = R"(name: rigs
+seeds: [1]
+scenarios:
+)";
+  const std::string tail = R"(  - {name: poster, file: b.yaml}
+methods: [klt-vio]
+estimator_config: tuning/indoor.yaml
+steps:
+  simulate: {command: [/bin/sh, -c, "mkdir -p {sequence}"]}
+)";
+  io::writeFileAtomic(dir.file("own.yaml"), head + "  - {name: mars, file: a.yaml, estimator_config: tuning/mars.yaml}\n" + tail);
+  io::writeFileAtomic(dir.file("shared.yaml"), head + "  - {name: mars, file: a.yaml}\n" + tail);
+  const Campaign c = loadCampaign(dir.file("own.yaml"));
+  const std::string indoor = fs::path(dir.file("tuning/indoor.yaml")).lexically_normal().string();
+  const std::string mars = fs::path(dir.file("tuning/mars.yaml")).lexically_normal().string();
+  EXPECT_EQ(c.scenarios[0].estimator_config, mars);
+  EXPECT_EQ(c.scenarios[1].estimator_config, "");
+  const auto jobs = expandJobs(c);
+  ASSERT_EQ(jobs.size(), 2u);
+  EXPECT_EQ(jobs[0].estimator_config, mars);
+  EXPECT_EQ(jobs[1].estimator_config, indoor);
+  const auto shared = expandJobs(loadCampaign(dir.file("shared.yaml")));
+  EXPECT_NE(jobs[0].id, shared[0].id);  // another configuration: another job
+  EXPECT_EQ(jobs[1].id, shared[1].id);  // the other scenario's jobs are unchanged
+  // So is another campaign-wide configuration: a resumed campaign re-runs its jobs.
+  io::writeFileAtomic(dir.file("tuning/indoor_v2.yaml"), "sync: {n_e: 3200}\n");
+  const auto renamed = expandJobs(loadCampaign(dir.file("shared.yaml"), {"estimator_config=tuning/indoor_v2.yaml"}));
+  EXPECT_NE(renamed[1].id, shared[1].id);
+
+  RunnerOptions o;
+  o.results = dir.file("results");
+  o.workers = 1;
+  o.evio_binary = "/bin/true";
+  (void)runCampaign(c, jobs, o);
+  for (const auto& job : jobs) {
+    const YAML::Node y = YAML::LoadFile((fs::path(jobFolder(o.results, job)) / "job.yaml").string());
+    EXPECT_EQ(y["estimator_config"].as<std::string>(), job.estimator_config);
+    for (const auto& step : y["steps"])
+      if (step["name"].as<std::string>() == "estimate") {
+        std::string line;
+        for (const auto& arg : step["command"]) line += (line.empty() ? "" : " ") + arg.as<std::string>();
+        EXPECT_NE(line.find(" --config " + job.estimator_config + " --method klt-vio "), std::string::npos) << line;
+      }
+  }
+  // A missing file is an error at load time naming the scenario's key and line.
+  io::writeFileAtomic(dir.file("bad.yaml"), head + "  - {name: mars, file: a.yaml, estimator_config: none.yaml}\n" + tail);
+  const std::string e = errorOf([&] { loadCampaign(dir.file("bad.yaml")); });
+  EXPECT_NE(e.find("bad.yaml:4: scenarios[0].estimator_config: no such file"), std::string::npos) << e;
+}
+
 TEST(CampaignRunner, ReScoresAFinishedEstimateWhenOnlyTheEvaluationChanged) {
   test::TempDir dir;
   // estimate counts itself in <dir>/estimates; evaluate writes the alignment

@@ -40,9 +40,13 @@ void SlamUpdater::diffuseSceneDepth(double dt_s) {
   state().P(s, s) += options().slam_scene_depth_share * sigma0 * sigma0 * dt_s / options().slam_scene_depth_memory_s;
 }
 
-bool SlamUpdater::dueForUpdate(const SlamFeature& f, TimeNs t_ns) const {
-  return options().slam_update_interval_s <= 0.0 ||
-         nsToSeconds(t_ns - f.last_update_ns) >= options().slam_update_interval_s - 1e-9;
+bool SlamUpdater::dueForUpdate(const SlamFeature& f, TimeNs t_ns, const Vec2& z) const {
+  const double interval = options().slam_update_interval_s;
+  const double displacement = options().slam_update_min_displacement_normalized;
+  if (interval <= 0.0 && displacement <= 0.0) return true;  // every measurement set
+  const bool waited = interval > 0.0 && nsToSeconds(t_ns - f.last_update_ns) >= interval - 1e-9;
+  const bool moved = displacement > 0.0 && (z - f.last_update_z).norm() >= displacement;
+  return waited || moved;
 }
 
 void SlamUpdater::marginalizeUnobserved(const std::vector<FeatureObservation>& observations) {
@@ -60,7 +64,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     const int j = state().findFeature(o.id);
     if (j < 0) continue;
     const auto jj = static_cast<std::size_t>(j);
-    if (!dueForUpdate(state().features[jj], state().clones[c].t_ns)) continue;
+    if (!dueForUpdate(state().features[jj], state().clones[c].t_ns, o.z)) continue;
     Eigen::Matrix<double, 2, Eigen::Dynamic> H;
     Vec2 r;
     MatX Hc;
@@ -83,6 +87,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     }
     f.gate_failures = 0;
     f.last_update_ns = state().clones[c].t_ns;
+    f.last_update_z = o.z;
     out.accepted.push_back(obs);  // the update whitens with the same W as the gate
   }
   return out;
@@ -139,7 +144,10 @@ bool SlamUpdater::initialize(const std::vector<FeatureId>& candidates, TrackMap*
       if (with_track == PriorWithTrack::kNotUsed) initializeWithPrior(track, c, prior);
     }
     // Every initialisation takes the track's observation in clone c (its last).
-    if (state().features.size() > features_before) state().features.back().last_update_ns = state().clones[c].t_ns;
+    if (state().features.size() > features_before) {
+      state().features.back().last_update_ns = state().clones[c].t_ns;
+      state().features.back().last_update_z = track.observations.back().z;
+    }
     tracks->erase(it);  // the track is a SLAM feature now, or failed its gate
   }
   return true;

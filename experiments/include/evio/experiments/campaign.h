@@ -13,6 +13,8 @@
 ///       file: ../scenarios/hover.yaml
 ///       set: {duration_s: 30}        # optional overrides for the simulate step
 ///       estimate_set: {backend.slam_min_depth_m: 5}   # optional estimate overrides for this scenario
+///       estimator_config: ../tuning/mars.yaml   # optional: this scenario's estimator configuration
+///                                  # instead of the campaign's (another rig's parameter set)
 ///     - name: recorded
 ///       sequence: /data/boxes_6dof   # an existing sequence folder: no simulate
 ///   methods:
@@ -42,8 +44,8 @@
 /// simulated or read), {job} (the job's folder). An argument that is exactly
 /// {simulate_set}, {estimate_set} or {evaluate_set} expands to the step's
 /// overrides as "--set key=value" pairs (none when empty); {estimator_config}
-/// to "--config <file>" when the campaign names one (`estimator_config:`,
-/// relative to the campaign file), else nothing; {method_option} to
+/// to "--config <file>" when the scenario or else the campaign names one
+/// (`estimator_config:`, relative to the campaign file), else nothing; {method_option} to
 /// "--method <method name>" unless the job's estimator settings set `method`
 /// themselves (a method named for its variant, e.g. `features15` with
 /// `set: {method: eklt-vio, …}`), else nothing. Defaults:
@@ -70,6 +72,7 @@ struct CampaignScenario {
   std::string sequence;  ///< existing sequence folder (absolute), for recorded ones
   Overrides set;         ///< simulate overrides
   Overrides estimate_set;  ///< estimate overrides for this scenario (before the method's), e.g. the depth prior
+  std::string estimator_config;  ///< absolute path of this scenario's estimator configuration, or empty (the campaign's)
 };
 
 struct CampaignMethod {
@@ -121,7 +124,8 @@ Campaign loadCampaign(const std::string& path, const std::vector<std::string>& o
 
 /// One cell of the matrix.
 struct Job {
-  std::string id;         ///< "<scenario>.<method>.s<seed>.<hash8>": stable across runs and machines
+  std::string id;         ///< "<scenario>.<method>.s<seed>.<hash8>": stable across runs and machines; the hash
+                          ///< covers the scenario, method, seed, every override and the estimator config's file name
   std::size_t scenario = 0;  ///< index into Campaign::scenarios
   std::size_t method = 0;    ///< index into Campaign::methods
   std::uint64_t seed = 0;
@@ -129,6 +133,7 @@ struct Job {
   Overrides simulate_set;   ///< scenario overrides + simulate sweeps
   Overrides estimate_set;   ///< method overrides + estimate sweeps
   Overrides evaluate_set;   ///< campaign evaluate options + evaluate sweeps
+  std::string estimator_config;  ///< the scenario's estimator configuration, else the campaign's (absolute, or empty)
   std::string sequence_key; ///< cache path "<scenario>.<hash8>/seed-<seed>" ("" for recorded sequences)
 };
 

@@ -92,6 +92,12 @@ struct BackendOptions {
   /// drawn initial error"); the skipped observations keep the feature alive
   /// but add no rows (docs/algorithms.md#correlated-measurements).
   double slam_update_interval_s = 0.0;
+  /// Or when the feature has moved at least this far in the image since its
+  /// last update, normalised image units (0: off). Motion brings new edges
+  /// under the tracker's patch: a displacement, not a time, decorrelates its
+  /// error. With both set, either lets an observation in; with only this,
+  /// a feature that does not move is not updated again.
+  double slam_update_min_displacement_normalized = 0.0;
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// A feature that takes a depth prior (fixed, map or range) takes it
   /// together with its track's observations in the window: the MAP (α, β, ρ)
@@ -292,6 +298,8 @@ struct BackendOptions {
     v("slam_max_gate_failures", slam_max_gate_failures, "gate failures removing a SLAM feature");
     v("slam_update_interval_s", slam_update_interval_s,
       "least time between two updates of one SLAM feature, s (0: every measurement set)");
+    v("slam_update_min_displacement_normalized", slam_update_min_displacement_normalized,
+      "or least image motion since its last update, normalised (0: off)");
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
     v("slam_prior_init_with_track", slam_prior_init_with_track,
       "a depth-prior SLAM initialisation also uses the track's observations in the window");

@@ -65,6 +65,9 @@ struct SlamFeature {
   /// Time of the clone whose observation last entered an update or the
   /// initialisation (BackendOptions::slam_update_interval_s), ns.
   TimeNs last_update_ns = 0;
+  /// That observation, normalised image coordinates
+  /// (BackendOptions::slam_update_min_displacement_normalized).
+  Vec2 last_update_z = Vec2::Zero();
 };
 
 /// Sizes of the error-state blocks.

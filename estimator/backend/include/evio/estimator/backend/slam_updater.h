@@ -47,8 +47,9 @@ class SlamUpdater : public Updater {
   void marginalizeUnobserved(const std::vector<FeatureObservation>& observations);
   /// The observations of SLAM features in clone c (position), each gated with
   /// 2 dof; a feature failing slam_max_gate_failures times in a row is gated out.
-  /// With slam_update_interval_s, an observation of a feature updated less
-  /// than that long before is left out (neither accepted nor gated).
+  /// With slam_update_interval_s (and/or slam_update_min_displacement_normalized),
+  /// an observation of a feature updated less than that long before (that
+  /// has moved less than that far since) is left out (neither accepted nor gated).
   SlamGate gate(const std::vector<FeatureObservation>& observations, std::size_t c);
   /// Rows of `accepted` at the linearisation point x (the iterated update
   /// calls it once per iteration), constrained; a feature missing from x or
@@ -108,8 +109,9 @@ class SlamUpdater : public Updater {
   /// is none or the ray does not meet the level plane in front of the camera.
   std::optional<double> rangeDepthPrior(const CameraClone& clone, const Vec2& z) const;
   void removeFeature(std::size_t j);
-  /// The feature's observation at t_ns may enter the update (slam_update_interval_s).
-  bool dueForUpdate(const SlamFeature& f, TimeNs t_ns) const;
+  /// The feature's observation z at t_ns may enter the update
+  /// (slam_update_interval_s, slam_update_min_displacement_normalized).
+  bool dueForUpdate(const SlamFeature& f, TimeNs t_ns, const Vec2& z) const;
 
   Camera camera_;
   double sigma_z_;

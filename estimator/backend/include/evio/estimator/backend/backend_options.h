@@ -93,10 +93,11 @@ struct BackendOptions {
   /// but add no rows (docs/algorithms.md#correlated-measurements).
   double slam_update_interval_s = 0.0;
   /// Or when the feature has moved at least this far in the image since its
-  /// last update, normalised image units (0: off). Motion brings new edges
-  /// under the tracker's patch: a displacement, not a time, decorrelates its
-  /// error. With both set, either lets an observation in; with only this,
-  /// a feature that does not move is not updated again.
+  /// last update, normalised image units (0: off): whether motion, which
+  /// brings new edges under the tracker's patch, decorrelates its error
+  /// better than time (measured: it does not, README "A parameter set for the
+  /// Mars rigs"). With both set, either lets an observation in; with only
+  /// this, a feature that does not move is not updated again.
   double slam_update_min_displacement_normalized = 0.0;
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// A feature that takes a depth prior (fixed, map or range) takes it

@@ -27,6 +27,21 @@ namespace fs = std::filesystem;
 
 using test::errorOf;
 
+/// The estimate step's command recorded in a job's job.yaml, as one line
+/// (arguments joined by spaces), or "" when the job has no estimate step.
+std::string estimateCommandLine(const std::string& job_folder) {
+  const YAML::Node y = YAML::LoadFile((fs::path(job_folder) / "job.yaml").string());
+  std::string line;
+  for (const auto& step : y["steps"]) {
+    if (step["name"].as<std::string>() != "estimate") continue;
+    for (const auto& arg : step["command"]) {
+      if (!line.empty()) line += ' ';
+      line += arg.as<std::string>();
+    }
+  }
+  return line;
+}
+
 /// A campaign whose steps are shell one-liners: "simulate" writes the
 /// sequence and counts itself in <dir>/simulations, "estimate" fails with
 /// exit code 3 for method "broken", "evaluate" writes a metrics.json whose
@@ -236,15 +251,7 @@ steps:
   const auto jobs = expandJobs(c);
   (void)runCampaign(c, jobs, o);
   std::map<std::string, std::string> estimate_command;
-  for (const auto& job : jobs) {
-    const YAML::Node y = YAML::LoadFile((fs::path(jobFolder(o.results, job)) / "job.yaml").string());
-    for (const auto& step : y["steps"])
-      if (step["name"].as<std::string>() == "estimate") {
-        std::string line;
-        for (const auto& arg : step["command"]) line += (line.empty() ? "" : " ") + arg.as<std::string>();
-        estimate_command[c.methods[job.method].name] = line;
-      }
-  }
+  for (const auto& job : jobs) estimate_command[c.methods[job.method].name] = estimateCommandLine(jobFolder(o.results, job));
   const std::string seq = jobs[0].sequence_key;
   EXPECT_EQ(estimate_command["klt-vio"],
             "/bin/true estimate " + (fs::path(o.results) / "sequences" / seq).string() + " --config " +
@@ -306,12 +313,8 @@ steps:
   for (const auto& job : jobs) {
     const YAML::Node y = YAML::LoadFile((fs::path(jobFolder(o.results, job)) / "job.yaml").string());
     EXPECT_EQ(y["estimator_config"].as<std::string>(), job.estimator_config);
-    for (const auto& step : y["steps"])
-      if (step["name"].as<std::string>() == "estimate") {
-        std::string line;
-        for (const auto& arg : step["command"]) line += (line.empty() ? "" : " ") + arg.as<std::string>();
-        EXPECT_NE(line.find(" --config " + job.estimator_config + " --method klt-vio "), std::string::npos) << line;
-      }
+    const std::string line = estimateCommandLine(jobFolder(o.results, job));
+    EXPECT_NE(line.find(" --config " + job.estimator_config + " --method klt-vio "), std::string::npos) << line;
   }
   // A missing file is an error at load time naming the scenario's key and line.
   io::writeFileAtomic(dir.file("bad.yaml"), head + "  - {name: mars, file: a.yaml, estimator_config: none.yaml}\n" + tail);

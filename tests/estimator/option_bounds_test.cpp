@@ -49,6 +49,7 @@ const std::vector<Bound>& bounds() {
       {"backend.max_delay_s", "60", "1e9"},
       {"backend.slam_update_interval_s", "60", "1e9"},
       {"backend.slam_update_min_displacement_normalized", "1", "2"},
+      {"backend.slam_error_correlation_time_s", "60", "1e9"},
       {"backend.static_window_s", "3600", "1e12"},
       {"frontend.eklt.max_features", "10000", "100000000"},
       {"frontend.eklt.harris_block_size", "101", "1000000"},

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <cmath>
+#include <limits>
 
 #include "evio/core/camera/camera_common.h"
 #include "evio/core/error.h"
@@ -78,6 +79,12 @@ Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& e
   if (llt.info() != Eigen::Success) return whiten;
   // cov = L Lᵀ ⇒ (σ_z L⁻¹) cov (σ_z L⁻¹)ᵀ = σ_z² I.
   return sigma_z * llt.matrixL().solve(Mat2::Identity());
+}
+
+double correlatedSampleVarianceFactor(double dt_s, double time_s) {
+  if (!(time_s > 0.0)) return 1.0;
+  if (!(dt_s > 0.0)) return std::numeric_limits<double>::infinity();
+  return 1.0 / std::tanh(0.5 * dt_s / time_s);
 }
 
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,

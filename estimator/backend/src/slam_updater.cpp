@@ -65,13 +65,18 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     if (j < 0) continue;
     const auto jj = static_cast<std::size_t>(j);
     if (!dueForUpdate(state().features[jj], state().clones[c].t_ns, o.z)) continue;
+    const double kappa = correlatedSampleVarianceFactor(
+        nsToSeconds(state().clones[c].t_ns - state().features[jj].last_update_ns),
+        options().slam_error_correlation_time_s);
+    if (!std::isfinite(kappa)) continue;  // observed in the clone of its last update: nothing new
     Eigen::Matrix<double, 2, Eigen::Dynamic> H;
     Vec2 r;
     MatX Hc;
     FeatureObservation obs = o;
+    obs.whiten = o.whiten / std::sqrt(kappa);  // covariance × κ (1 without slam_error_correlation_time_s)
     Mat2 second_order;
     if (options().slam_second_order_noise && slamSecondOrderCovariance(state(), jj, c, &second_order))
-      obs.whiten = whitenWithExtraCovariance(o.whiten, sigma_z_, second_order);
+      obs.whiten = whitenWithExtraCovariance(obs.whiten, sigma_z_, second_order);
     const bool ok = slamResidual(state(), jj, c, o.z, &H, &r);
     if (ok) {
       H = obs.whiten * H;  // whitened to σ_z² I (feature_track.h)

@@ -38,6 +38,15 @@ bool slamSecondOrderCovariance(const FilterState& state, std::size_t j, std::siz
 /// W'(σ_z² W⁻¹W⁻ᵀ + extra)W'ᵀ = σ_z² I.
 Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra);
 
+/// The variance factor κ of one of a run of samples dt_s apart whose common
+/// error is a first-order Gauss–Markov process with time constant time_s:
+/// with ρ = exp(−dt/τ), N such samples carry as much information about a
+/// constant as N (1 − ρ)/(1 + ρ) independent ones, so each counts as one
+/// sample with its variance times
+///   κ = (1 + ρ)/(1 − ρ) = coth(dt / 2τ)   (≈ 2τ/dt for dt ≪ τ, → 1 for dt ≫ τ).
+/// 1 when time_s ≤ 0 (no correlation); +∞ when dt_s ≤ 0 (the same instant).
+double correlatedSampleVarianceFactor(double dt_s, double time_s);
+
 /// The track-error states (filter_state.h, feature_dim = 5) over dt_s: each
 /// e is a first-order Gauss–Markov process with correlation time time_s and
 /// stationary covariance Σ_e (state.track_error_cov), so exactly, for any dt,

@@ -472,6 +472,25 @@ TEST(BackendUpdaters, SlamErrorCorrelationTimeWidensEachObservationByItsEffectiv
   EXPECT_EQ(b.state.features[0].last_update_ns, secondsToNs(0.060));
 }
 
+TEST(BackendUpdaters, SlamErrorCorrelationTimeLeavesTheGateToTheObservationsOwnCovariance) {
+  // An observation 0.06 off the prediction, 10 ms after the last update:
+  // the gate rejects it with its own covariance (W), and would pass it with
+  // the covariance × κ = coth(10 ms / 40 ms) = 4.08 it enters an update with
+  // at τ = 20 ms (W/√κ). With τ = 20 ms the gate still rejects it.
+  constexpr double kOffset = 0.06;
+  const auto rejected = [](double tau_s, const Mat2& whiten) {
+    UpdaterBench b = timedSlamBench({0.0, 0.010});
+    b.options.slam_error_correlation_time_s = tau_s;
+    SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
+    slam.gate({{9, Vec2(0.1 + kOffset, -0.2), whiten}}, 1);
+    return b.stats.slam_updates_rejected == 1;
+  };
+  const double kappa = 1.0 / std::tanh(0.25);
+  EXPECT_TRUE(rejected(0.0, Mat2::Identity()));
+  EXPECT_FALSE(rejected(0.0, Mat2::Identity() / std::sqrt(kappa)));
+  EXPECT_TRUE(rejected(0.02, Mat2::Identity()));
+}
+
 TEST(BackendUpdaters, ANewSlamFeatureCountsItsInitialisationAsItsLastUpdate) {
   UpdaterBench b(cloneRow({0.0, 0.0}));
   b.state.clones[0].t_ns = secondsToNs(1.0);

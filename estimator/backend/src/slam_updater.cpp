@@ -73,10 +73,9 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     Vec2 r;
     MatX Hc;
     FeatureObservation obs = o;
-    obs.whiten = o.whiten / std::sqrt(kappa);  // covariance × κ (1 without slam_error_correlation_time_s)
     Mat2 second_order;
     if (options().slam_second_order_noise && slamSecondOrderCovariance(state(), jj, c, &second_order))
-      obs.whiten = whitenWithExtraCovariance(obs.whiten, sigma_z_, second_order);
+      obs.whiten = whitenWithExtraCovariance(o.whiten, sigma_z_, second_order);
     const bool ok = slamResidual(state(), jj, c, o.z, &H, &r);
     if (ok) {
       H = obs.whiten * H;  // whitened to σ_z² I (feature_track.h)
@@ -93,7 +92,11 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     f.gate_failures = 0;
     f.last_update_ns = state().clones[c].t_ns;
     f.last_update_z = o.z;
-    out.accepted.push_back(obs);  // the update whitens with the same W as the gate
+    // The gate tests one observation against its own (marginal) covariance;
+    // the update takes it as one of a run of correlated samples, its
+    // covariance × κ (1 without slam_error_correlation_time_s: the gate's W).
+    obs.whiten /= std::sqrt(kappa);
+    out.accepted.push_back(obs);
   }
   return out;
 }

@@ -50,10 +50,10 @@ class SlamUpdater : public Updater {
   /// With slam_update_interval_s (and/or slam_update_min_displacement_normalized),
   /// an observation of a feature updated less than that long before (that
   /// has moved less than that far since) is left out (neither accepted nor gated).
-  /// With slam_error_correlation_time_s τ, each observation's covariance is
-  /// multiplied by coth(Δt / 2τ), Δt the time since the feature's last
-  /// update (correlatedSampleVarianceFactor); the accepted observations
-  /// carry that whitening into the update.
+  /// With slam_error_correlation_time_s τ, the gate tests each observation
+  /// with its own covariance, and an accepted one carries that covariance
+  /// multiplied by coth(Δt / 2τ) into the update, Δt the time since the
+  /// feature's last update (correlatedSampleVarianceFactor).
   SlamGate gate(const std::vector<FeatureObservation>& observations, std::size_t c);
   /// Rows of `accepted` at the linearisation point x (the iterated update
   /// calls it once per iteration), constrained; a feature missing from x or

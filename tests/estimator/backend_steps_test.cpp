@@ -437,7 +437,7 @@ TEST(SlamFeatures, CorrelatedSampleFactorIsTheVarianceOfTheMeanOfFirstOrderMarko
   EXPECT_TRUE(std::isinf(correlatedSampleVarianceFactor(0.0, 0.02)));                 // the same instant
 }
 
-TEST(BackendUpdaters, SlamErrorCorrelationTimeWidensEachObservationByItsEffectiveSampleFactor) {
+TEST(BackendUpdaters, TrackErrorTimeWidensEachSlamObservationByItsEffectiveSampleFactor) {
   // The feature initialised at t = 0, observed exactly at 10, 30 and 60 ms
   // with an anisotropic whitening W. With τ = 20 ms each accepted
   // observation's whitening is W / √coth(Δt/2τ), Δt the time since the last
@@ -448,7 +448,7 @@ TEST(BackendUpdaters, SlamErrorCorrelationTimeWidensEachObservationByItsEffectiv
   W << 0.8, 0.1, 0.0, 0.5;
   FeatureObservation seen{9, Vec2(0.1, -0.2), W};
   const auto whitening_at = [&](double tau_s) {
-    b.options.slam_error_correlation_time_s = tau_s;
+    seen.error_time_s = tau_s;  // as the tracker states it
     b.state.features[0].last_update_ns = 0;
     SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
     std::vector<Mat2> out;
@@ -472,7 +472,7 @@ TEST(BackendUpdaters, SlamErrorCorrelationTimeWidensEachObservationByItsEffectiv
   EXPECT_EQ(b.state.features[0].last_update_ns, secondsToNs(0.060));
 }
 
-TEST(BackendUpdaters, SlamErrorCorrelationTimeLeavesTheGateToTheObservationsOwnCovariance) {
+TEST(BackendUpdaters, TrackErrorTimeLeavesTheSlamGateToTheObservationsOwnCovariance) {
   // An observation 0.06 off the prediction, 10 ms after the last update:
   // the gate rejects it with its own covariance (W), and would pass it with
   // the covariance × κ = coth(10 ms / 40 ms) = 4.08 it enters an update with
@@ -480,9 +480,8 @@ TEST(BackendUpdaters, SlamErrorCorrelationTimeLeavesTheGateToTheObservationsOwnC
   constexpr double kOffset = 0.06;
   const auto rejected = [](double tau_s, const Mat2& whiten) {
     UpdaterBench b = timedSlamBench({0.0, 0.010});
-    b.options.slam_error_correlation_time_s = tau_s;
     SlamUpdater slam(b.context(), kCamera, 0.01, &b.chi2, &b.chi2, nullptr);
-    slam.gate({{9, Vec2(0.1 + kOffset, -0.2), whiten}}, 1);
+    slam.gate({{9, Vec2(0.1 + kOffset, -0.2), whiten, true, tau_s}}, 1);
     return b.stats.slam_updates_rejected == 1;
   };
   const double kappa = 1.0 / std::tanh(0.25);

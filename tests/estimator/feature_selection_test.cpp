@@ -48,6 +48,7 @@ TEST(BackendSteps, UndistortObservationsWhitensAStatedCovarianceToSigmaZ) {
   c.uv = Vec2(80, 30);
   c.cov_px << 1.0, 2.0, 2.0, 1.0;  // indefinite
   c.informative = false;
+  c.error_time_s = 0.054;
   set.features = {a, b, c};
   BackendStats stats;
   const double sigma_z = 0.05;
@@ -61,6 +62,8 @@ TEST(BackendSteps, UndistortObservationsWhitensAStatedCovarianceToSigmaZ) {
   EXPECT_EQ(obs[2].whiten, Mat2::Identity());
   EXPECT_TRUE(obs[0].informative);
   EXPECT_FALSE(obs[2].informative);
+  EXPECT_EQ(obs[0].error_time_s, 0.0);
+  EXPECT_EQ(obs[2].error_time_s, 0.054);  // the tracker's statement, as it came
 }
 
 // A feature flagged not informative keeps its track alive (not lost, not

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
 
 #include "evio/core/io/config.h"
 #include "evio/core/so3.h"
@@ -213,6 +216,31 @@ TEST(Frontend, KltGyroPredictionTakesTheExtrinsicsAndTheImu) {
   EXPECT_THROW(Frontend(options, cam), Error);
   EXPECT_TRUE(Frontend(options, cam, Pose()).tracker().usesImu());
   EXPECT_TRUE(Frontend(options, cam, Pose()).usesImu());  // evio track reads the IMU then
+}
+
+// Every track point the frontend hands out states the error time constant
+// of the tracker that made it (its options section's error_time_s), and
+// only that tracker's: the other sections' values are not used.
+TEST(Frontend, TrackPointsStateTheirTrackersErrorTimeConstant) {
+  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+  cv::Mat image(180, 240, CV_8UC1, cv::Scalar(20));
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 5; ++c) image(cv::Rect(30 + 40 * c, 25 + 35 * r, 16, 16)).setTo(cv::Scalar(220));
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);  // corners with one strongest pixel (FAST's suppression)
+  for (const std::string tracker : {"klt", "eklt"}) {
+    FrontendOptions options;
+    options.tracker = tracker;
+    options.klt.error_time_s = 0.5;
+    options.eklt.error_time_s = 0.054;
+    options.haste.error_time_s = 0.01;
+    Frontend frontend(options, cam);
+    frontend.addFrame(secondsToNs(0.1), image);
+    frontend.addFrame(secondsToNs(0.15), image);  // EKLT's seeds start on the second frame
+    TrackPoints points;
+    frontend.drainTrackPoints(points);
+    ASSERT_FALSE(points.empty()) << tracker;
+    for (const TrackPoint& p : points) EXPECT_EQ(p.error_time_s, tracker == "klt" ? 0.5 : 0.054) << tracker;
+  }
 }
 
 TEST(FrontendOptions, DefaultsRoundTripThroughYamlAndOverridesAreChecked) {

@@ -54,7 +54,7 @@ TEST(Synchronizer, EveryNeEventsExtrapolatesLinearlyToTheLatestTrackTime) {
 // until a newer point replaces it; repeats of an old point and positions
 // closer than min_displacement_px to the last informative one are flagged
 // not informative.
-TEST(Synchronizer, CarriesThePointCovarianceAndFlagsRepeatedOrStillPositions) {
+TEST(Synchronizer, CarriesThePointCovarianceAndErrorTimeAndFlagsRepeatedOrStillPositions) {
   SynchronizerOptions o;
   o.n_e = 10;
   o.drop_repeated_points = true;
@@ -63,6 +63,7 @@ TEST(Synchronizer, CarriesThePointCovarianceAndFlagsRepeatedOrStillPositions) {
   TrackPoint a = point(1, 0.00, Vec2(10, 10), TrackStatus::kNew);
   TrackPoint b = point(2, 0.00, Vec2(50, 50), TrackStatus::kNew);
   a.cov_px << 0.04, 0.01, 0.01, 0.09;
+  a.error_time_s = 0.054;
   sync.addTrackPoints({a, b});
   sync.addEvents(10, secondsToNs(0.0));
   MeasurementSet set;
@@ -70,16 +71,20 @@ TEST(Synchronizer, CarriesThePointCovarianceAndFlagsRepeatedOrStillPositions) {
   ASSERT_EQ(set.features.size(), 2u);
   EXPECT_EQ(set.features[0].cov_px, a.cov_px);
   EXPECT_EQ(set.features[1].cov_px, Mat2::Zero());  // not stated
+  EXPECT_EQ(set.features[0].error_time_s, 0.054);
+  EXPECT_EQ(set.features[1].error_time_s, 0.0);  // not stated: independent
   EXPECT_TRUE(set.features[0].informative);
   EXPECT_TRUE(set.features[1].informative);
 
   // Track 1 moves 0.5 px (below the threshold), track 2 has no new point.
   TrackPoint a2 = point(1, 0.01, Vec2(10.5, 10));
   a2.cov_px = 4.0 * Mat2::Identity();
+  a2.error_time_s = 0.02;
   sync.addTrackPoints({a2});
   sync.addEvents(10, secondsToNs(0.01));
   ASSERT_TRUE(sync.poll(&set));
   EXPECT_EQ(set.features[0].cov_px, a2.cov_px);
+  EXPECT_EQ(set.features[0].error_time_s, 0.02);  // the newest point's
   EXPECT_FALSE(set.features[0].informative);  // 0.5 px < 1 px
   EXPECT_FALSE(set.features[1].informative);  // a repeat of the point at 0 s
 

@@ -133,7 +133,7 @@ void flatten(const YAML::Node& node, const std::string& prefix, std::map<std::st
 
 TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButItsOneSetting) {
   // estimator/config/sim_mars.yaml says it is sim.yaml with one setting
-  // changed (README "A parameter set for the Mars rigs"); a change to one
+  // changed (README "Correlated errors: the options side by side"); a change to one
   // file that forgets the other fails here.
   const fs::path config = fs::path(EVIO_SOURCE_DIR) / "estimator" / "config";
   std::map<std::string, std::string> indoor, mars;
@@ -144,7 +144,7 @@ TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButItsOneSetting) {
     if (indoor.count(key) == 0 || indoor.at(key) != value) differ[key] = value;
   for (const auto& [key, value] : indoor)
     if (mars.count(key) == 0) differ[key] = "(missing)";
-  EXPECT_EQ(differ, (std::map<std::string, std::string>{{"backend.slam_update_interval_s", "0.04"}}));
+  EXPECT_EQ(differ, (std::map<std::string, std::string>{{"frontend.eklt.error_time_s", "0.054"}}));
 }
 
 }  // namespace

@@ -39,7 +39,6 @@ void BackendOptions::validate() const {
   requireField(slam_max_gate_failures >= 1, "slam_max_gate_failures", "must be >= 1");
   requireInRange("slam_update_interval_s", slam_update_interval_s, 0.0, 60.0);
   requireInRange("slam_update_min_displacement_normalized", slam_update_min_displacement_normalized, 0.0, 1.0);
-  requireInRange("slam_error_correlation_time_s", slam_error_correlation_time_s, 0.0, 60.0);
   requireInRange("slam_fixed_prior_wait_s", slam_fixed_prior_wait_s, 0.0, 1e9);
   requireNonNegative("slam_prior_track_min_parallax_px", slam_prior_track_min_parallax_px);
   requireField(slam_prior_track_iterations >= 1 && slam_prior_track_iterations <= 50, "slam_prior_track_iterations",

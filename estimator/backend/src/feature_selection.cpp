@@ -45,7 +45,8 @@ std::vector<FeatureObservation> undistortObservations(const MeasurementSet& set,
     }
     const bool stated = m.cov_px != Mat2::Zero();
     out.push_back({m.id, bearing.head<2>() / bearing.z(),
-                   stated ? whiteningFor(K_inv * m.cov_px * K_inv, sigma_z) : Mat2::Identity(), m.informative});
+                   stated ? whiteningFor(K_inv * m.cov_px * K_inv, sigma_z) : Mat2::Identity(), m.informative,
+                   m.error_time_s});
   }
   return out;
 }

@@ -67,7 +67,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     if (!dueForUpdate(state().features[jj], state().clones[c].t_ns, o.z)) continue;
     const double kappa = correlatedSampleVarianceFactor(
         nsToSeconds(state().clones[c].t_ns - state().features[jj].last_update_ns),
-        options().slam_error_correlation_time_s);
+        o.error_time_s);
     if (!std::isfinite(kappa)) continue;  // observed in the clone of its last update: nothing new
     Eigen::Matrix<double, 2, Eigen::Dynamic> H;
     Vec2 r;
@@ -94,7 +94,7 @@ SlamGate SlamUpdater::gate(const std::vector<FeatureObservation>& observations, 
     f.last_update_z = o.z;
     // The gate tests one observation against its own (marginal) covariance;
     // the update takes it as one of a run of correlated samples, its
-    // covariance × κ (1 without slam_error_correlation_time_s: the gate's W).
+    // covariance × κ (1 for a tracker that states no error time constant: the gate's W).
     obs.whiten /= std::sqrt(kappa);
     out.accepted.push_back(obs);
   }

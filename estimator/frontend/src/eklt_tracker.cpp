@@ -47,6 +47,7 @@ void EkltOptions::validate() const {
   requireInRange("position_sigma_min_px", position_sigma_min_px, 1e-3, 100.0);
   requireField(position_sigma_max_px >= position_sigma_min_px && position_sigma_max_px <= 100.0,
                "position_sigma_max_px", "must be in [position_sigma_min_px, 100]");
+  requireInRange("error_time_s", error_time_s, 0.0, 60.0);
   requireField(bootstrap_window_px >= 3 && bootstrap_window_px <= 255, "bootstrap_window_px", "must be in [3, 255]");
   requireField(bootstrap_pyramid_levels >= 1 && bootstrap_pyramid_levels <= 16, "bootstrap_pyramid_levels",
                "must be in [1, 16]");

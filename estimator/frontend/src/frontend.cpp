@@ -52,6 +52,9 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
     tracker_ = std::make_unique<KltTracker>(options_.klt, camera, T_B_C);
   if (options_.image_source == "reconstructed")
     reconstructor_ = std::make_unique<ImageReconstructor>(options_.reconstruction, camera.width(), camera.height());
+  error_time_s_ = options_.tracker == "eklt"    ? options_.eklt.error_time_s
+                  : options_.tracker == "haste" ? options_.haste.error_time_s
+                                                : options_.klt.error_time_s;
   if (options_.track_lag.estimate && options_.tracker != "klt")
     probe_ = std::make_unique<FrameLagProbe>(options_.track_lag);
 }
@@ -87,13 +90,19 @@ void Frontend::addEventChunks(const EventArray& events, const std::vector<std::s
   events_ += chunk_ends.empty() ? 0 : chunk_ends.back();
   const std::size_t begin = out.size();
   tracker_->addEventChunks(events, chunk_ends, out, point_ends);
+  stateErrorTime(out, begin);
   if (probe_) probe_->observe(out, begin);
 }
 
 void Frontend::drainTrackPoints(TrackPoints& out) {
   const std::size_t begin = out.size();
   tracker_->drainTrackPoints(out);
+  stateErrorTime(out, begin);
   if (probe_) probe_->observe(out, begin);
+}
+
+void Frontend::stateErrorTime(TrackPoints& points, std::size_t begin) const {
+  for (std::size_t i = begin; i < points.size(); ++i) points[i].error_time_s = error_time_s_;
 }
 
 void Frontend::addFrame(TimeNs t_ns, const cv::Mat& image) {

@@ -38,6 +38,7 @@ void HasteOptions::validate() const {
   requireField(history_events >= 0 && history_events <= (1 << 24), "history_events", "must be in [0, 16777216]");
   requireInRange("seed_timeout_s", seed_timeout_s, 1e-6, 1e6);
   requireInRange("lost_border_px", lost_border_px, 0.0, 1000.0);
+  requireInRange("error_time_s", error_time_s, 0.0, 60.0);
 }
 
 }  // namespace evio::estimator

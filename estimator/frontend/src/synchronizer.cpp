@@ -43,6 +43,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
       if (p.t_ns == tr.t[1]) {
         tr.uv[1] = p.uv;
         tr.cov = p.cov_px;
+        tr.error_time_s = p.error_time_s;
         tr.moved = true;
       }
       continue;
@@ -52,6 +53,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     tr.t[1] = p.t_ns;
     tr.uv[1] = p.uv;
     tr.cov = p.cov_px;
+    tr.error_time_s = p.error_time_s;
     tr.n = std::min(tr.n + 1, 2);
     tr.moved = true;
     newest = std::max(newest, p.t_ns);
@@ -132,6 +134,7 @@ void Synchronizer::update(TimeNs t_ns) {
     m.id = id;
     m.uv = extrapolate(tr, t_ns + latency_ns_);
     m.cov_px = tr.cov;
+    m.error_time_s = tr.error_time_s;
     m.informative = (!options_.drop_repeated_points || tr.moved) &&
                     (!tr.informed || (m.uv - tr.last_informative).norm() >= options_.min_displacement_px);
     if (m.informative) {

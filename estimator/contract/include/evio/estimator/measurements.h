@@ -48,6 +48,10 @@ struct TrackPoint {
   /// (EKLT: from the curvature of its cost, eklt_cost.h). Zero: not stated,
   /// the backend uses its configured σ_img.
   Mat2 cov_px = Mat2::Zero();
+  /// Time constant of the tracker's error on this track, s, as the tracker
+  /// states it (its option error_time_s): the error of points Δt apart is
+  /// correlated as e^(−Δt/τ). 0: independent from point to point.
+  double error_time_s = 0.0;
 };
 
 using TrackPoints = std::vector<TrackPoint>;
@@ -64,6 +68,10 @@ struct FeatureMeasurement {
   /// Covariance of uv, px²; zero: not stated (the backend's σ_img). The
   /// covariance of the track point uv comes from (not grown by extrapolation).
   Mat2 cov_px = Mat2::Zero();
+  /// The time constant of the tracker's error stated with that point
+  /// (TrackPoint::error_time_s); the backend weighs a SLAM feature's
+  /// observations by it (docs/algorithms.md#correlated-measurements).
+  double error_time_s = 0.0;
   /// False when uv repeats what an earlier update already told (no new track
   /// point, or less motion than the synchroniser's min_displacement_px since
   /// the last informative position): the backend keeps the feature alive

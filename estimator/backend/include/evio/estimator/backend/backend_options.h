@@ -99,15 +99,6 @@ struct BackendOptions {
   /// Mars rigs"). With both set, either lets an observation in; with only
   /// this, a feature that does not move is not updated again.
   double slam_update_min_displacement_normalized = 0.0;
-  /// A SLAM observation's covariance is multiplied by the effective-sample
-  /// factor κ = coth(Δt / 2τ) of a track error correlated like a first-order
-  /// Gauss–Markov process with this time constant τ, s (0: off), where Δt is
-  /// the time since the feature's last update or initialisation: N samples
-  /// Δt apart with correlation ρ = e^(−Δt/τ) carry as much information about
-  /// a constant as N (1 − ρ)/(1 + ρ) independent ones. Observations weighted
-  /// by their effective number instead of left out (slam_update_interval_s)
-  /// (docs/algorithms.md#correlated-measurements).
-  double slam_error_correlation_time_s = 0.0;
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// A feature that takes a depth prior (fixed, map or range) takes it
   /// together with its track's observations in the window: the MAP (α, β, ρ)
@@ -310,8 +301,6 @@ struct BackendOptions {
       "least time between two updates of one SLAM feature, s (0: every measurement set)");
     v("slam_update_min_displacement_normalized", slam_update_min_displacement_normalized,
       "or least image motion since its last update, normalised (0: off)");
-    v("slam_error_correlation_time_s", slam_error_correlation_time_s,
-      "a SLAM observation's covariance times coth(dt / 2 tau), tau this time constant, s (0: off)");
     v("slam_triangulated_init", slam_triangulated_init, "SLAM init from triangulation when possible");
     v("slam_prior_init_with_track", slam_prior_init_with_track,
       "a depth-prior SLAM initialisation also uses the track's observations in the window");

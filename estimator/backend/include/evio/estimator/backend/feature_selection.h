@@ -26,6 +26,7 @@ struct FeatureObservation {
   /// FeatureMeasurement::informative: false keeps the feature alive (SLAM
   /// feature not marginalised, track not lost) without an observation.
   bool informative = true;
+  double error_time_s = 0.0;  ///< FeatureMeasurement::error_time_s
 };
 
 using TrackMap = std::map<FeatureId, FeatureTrack>;

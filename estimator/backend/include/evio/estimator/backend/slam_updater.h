@@ -50,7 +50,8 @@ class SlamUpdater : public Updater {
   /// With slam_update_interval_s (and/or slam_update_min_displacement_normalized),
   /// an observation of a feature updated less than that long before (that
   /// has moved less than that far since) is left out (neither accepted nor gated).
-  /// With slam_error_correlation_time_s τ, the gate tests each observation
+  /// With an error time constant τ stated by the tracker (FeatureObservation::
+  /// error_time_s, from TrackPoint::error_time_s), the gate tests each observation
   /// with its own covariance, and an accepted one carries that covariance
   /// multiplied by coth(Δt / 2τ) into the update, Δt the time since the
   /// feature's last update (correlatedSampleVarianceFactor).

@@ -99,6 +99,13 @@ struct EkltOptions {
   /// Cap of the position σ, px: the directions the patch does not constrain
   /// (along a straight edge) get this σ (the former fixed σ_img, 5 px).
   double position_sigma_max_px = 5.0;
+  /// Time constant of the track error stated with every point
+  /// (TrackPoint::error_time_s), s; 0: independent from point to point. The
+  /// backend weighs a SLAM feature's observations by it (docs/algorithms.md
+  /// "SLAM observations weighted by their effective number"). Measured on
+  /// EKLT's tracks against the truth: correlation 0.83 at 10 ms on the Mars
+  /// circle (τ ≈ 54 ms), 0.89 on the poster (τ ≈ 86 ms).
+  double error_time_s = 0.0;
 
   // Bootstrap (KLT between the detection frame and the next frame).
   int bootstrap_window_px = 20;        ///< Lucas–Kanade window side
@@ -133,6 +140,7 @@ struct EkltOptions {
     v("position_covariance", position_covariance, "attach the position covariance from the cost curvature");
     v("position_sigma_min_px", position_sigma_min_px, "floor of the position sigma, px");
     v("position_sigma_max_px", position_sigma_max_px, "cap of the position sigma, px");
+    v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
     v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");
     v("bootstrap_pyramid_levels", bootstrap_pyramid_levels, "bootstrap KLT pyramid levels");
     v("imu_prediction", imu_prediction, "predict feature positions from the gyro");

@@ -87,7 +87,9 @@ class Frontend {
   void addFrame(TimeNs t_ns, const cv::Mat& image);
   void addImu(const ImuSample& sample);
 
-  /// Appends the track points since the last call (the lag probe sees them too).
+  /// Appends the track points since the last call (the lag probe sees them
+  /// too), each stating the tracker's error time constant (error_time_s of
+  /// its options section).
   void drainTrackPoints(TrackPoints& out);
   /// True when the events of several chunks may be tracked in one call:
   /// nothing but events changes the tracker between them (no reconstruction;
@@ -111,7 +113,11 @@ class Frontend {
   std::uint64_t numReconstructedFrames() const { return reconstructed_frames_; }
 
  private:
+  /// points[begin, end) take the tracker's error time constant.
+  void stateErrorTime(TrackPoints& points, std::size_t begin) const;
+
   FrontendOptions options_;
+  double error_time_s_ = 0.0;  ///< the tracker's options' error_time_s
   std::unique_ptr<FeatureTracker> tracker_;
   std::unique_ptr<ImageReconstructor> reconstructor_;
   std::unique_ptr<FrameLagProbe> probe_;

@@ -64,6 +64,9 @@ struct HasteOptions {
 
   // Ending tracks.
   double lost_border_px = 15.0;      ///< lost when the state comes closer than this to the image edge
+  /// Time constant of the track error stated with every point, s (0:
+  /// independent; as EkltOptions::error_time_s).
+  double error_time_s = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -85,6 +88,7 @@ struct HasteOptions {
     v("seed_timeout_s", seed_timeout_s, "drop a seed whose window is not full after this long, s");
     v("one_point_per_window", one_point_per_window, "send a new state at most once per window time span");
     v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
+    v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
   }
 
   void validate() const;

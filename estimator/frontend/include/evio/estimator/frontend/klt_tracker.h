@@ -43,6 +43,9 @@ struct KltOptions {
   double ransac_threshold_px = 0.6;  ///< epipolar distance, px of the undistorted image
   double ransac_confidence = 0.99;   ///< RANSAC confidence
   bool imu_prediction = false;       ///< start each search at the gyro's prediction (needs IMU and T_B_C)
+  /// Time constant of the track error stated with every point, s (0:
+  /// independent; as EkltOptions::error_time_s).
+  double error_time_s = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -60,6 +63,7 @@ struct KltOptions {
     v("ransac_threshold_px", ransac_threshold_px, "RANSAC threshold, px of the undistorted image");
     v("ransac_confidence", ransac_confidence, "RANSAC confidence");
     v("imu_prediction", imu_prediction, "start each Lucas-Kanade search at the gyro's prediction");
+    v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
   }
   void validate() const;
 };

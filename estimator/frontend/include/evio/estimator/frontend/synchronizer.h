@@ -23,8 +23,8 @@
 /// At an update every live track is linearly extrapolated to the update time
 /// from its last two points (held when it has one; at most
 /// max_extrapolation_s beyond its last point), and carries the position it
-/// was sent with at the previous update and the covariance its tracker
-/// stated for its newest point.
+/// was sent with at the previous update and the covariance and error time
+/// constant its tracker stated for its newest point.
 
 #include <cstdint>
 #include <deque>
@@ -113,6 +113,7 @@ class Synchronizer {
     TimeNs t[2] = {0, 0};   // last two points, t[1] newest
     Vec2 uv[2] = {Vec2::Zero(), Vec2::Zero()};
     Mat2 cov = Mat2::Zero();  // of the newest point, px² (zero: not stated)
+    double error_time_s = 0.0;  // of the newest point (TrackPoint::error_time_s)
     bool informed = false;    // an informative position was sent
     Vec2 last_informative = Vec2::Zero();
     int n = 0;

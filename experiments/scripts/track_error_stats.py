@@ -28,6 +28,11 @@ its age the time since the track's first point with a truth. Printed:
     e(t) − e(t0), which is what a filter that took the first point as the
     feature's bearing sees.
 
+  * the tails: the share of points with |e| beyond 1, 2 and 3 px, and the
+    runs of consecutive points of one track beyond --off-px (a track that
+    sits on a wrong alignment for a while, not a single bad point): how many
+    runs last --off-run points or more, and how many points they hold.
+
 Points whose error exceeds --max-error (px) are left out of every figure
 but the point count: gross losses, which the filter's gate rejects, would
 otherwise set the RMS and the correlations. The correlation interpolates
@@ -35,6 +40,7 @@ across the gaps they leave.
 
 Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
        [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
+       [--off-px 2] [--off-run 10]
 """
 import argparse
 import sys
@@ -90,6 +96,23 @@ def correlation(errs, lag, since_start):
     return (num / np.sqrt(a2 * b2) if a2 > 0 and b2 > 0 else float("nan")), n
 
 
+def off_runs(errs, off_px):
+    """Lengths (points) of the runs of consecutive points of one track with
+    |e| > off_px."""
+    runs = []
+    for _, e, _ in errs.values():
+        length = 0
+        for off in np.linalg.norm(e, axis=1) > off_px:
+            if off:
+                length += 1
+            elif length:
+                runs.append(length)
+                length = 0
+        if length:
+            runs.append(length)
+    return np.array(runs, dtype=int)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("tracks")
@@ -98,6 +121,8 @@ def main():
     ap.add_argument("--age-bins", default="0,0.1,0.2,0.4,0.8,1.6,3.2,100")
     ap.add_argument("--skip-s", type=float, default=0.0, help="ignore points before this time, s")
     ap.add_argument("--max-error", type=float, default=5.0, help="leave out points with |e| above this, px")
+    ap.add_argument("--off-px", type=float, default=2.0, help="a point is off beyond this |e|, px")
+    ap.add_argument("--off-run", type=int, default=10, help="count runs of at least this many off points")
     a = ap.parse_args()
     errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
     if not errs:
@@ -129,6 +154,12 @@ def main():
         A = np.stack([np.ones(len(var)), np.array(mean_age)], axis=1)
         (v0, q), *_ = np.linalg.lstsq(A * w[:, None], np.array(var) * w, rcond=None)
         print(f"per-axis variance ≈ {v0:.3f} px² + {q:.3f} px²/s · age")
+    norm = np.linalg.norm(e, axis=1)
+    print("points beyond 1 / 2 / 3 px: " + " / ".join(f"{100 * np.mean(norm > x):.1f} %" for x in (1, 2, 3)))
+    runs = off_runs(errs, a.off_px)
+    long_runs = runs[runs >= a.off_run]
+    print(f"runs beyond {a.off_px:g} px: {len(runs)}; {len(long_runs)} of at least {a.off_run} points, "
+          f"holding {int(long_runs.sum())} points")
     print("lag (s)  corr e(t)   pairs    corr e(t)-e(t0)")
     for lag in (float(x) for x in a.lags.split(",")):
         c, n = correlation(errs, lag, False)

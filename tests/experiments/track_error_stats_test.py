@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""experiments/scripts/track_error_stats.py's tails on hand-made tracks whose
+errors are known exactly: the shares of points beyond 1, 2 and 3 px and the
+runs of consecutive points of one track beyond --off-px, counted per track
+(a run never joins two tracks) with the points past --max-error left out."""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+SCRIPT = os.path.join(os.path.dirname(__file__), "..", "..", "experiments", "scripts", "track_error_stats.py")
+
+
+def write(path, rows):
+    with open(path, "w") as f:
+        f.write("# id t x y\n")
+        for fid, t, x, y in rows:
+            f.write(f"{fid} {t:.3f} {x} {y}\n")
+
+
+def run(tracks, truth, *args):
+    return subprocess.run([sys.executable, SCRIPT, tracks, truth, "--lags", "0.01", *args],
+                          capture_output=True, text=True)
+
+
+class TrackErrorTails(unittest.TestCase):
+    def test_shares_and_runs_beyond_the_thresholds(self):
+        # Errors along x, px: track 1 has a run of three points beyond 2 px
+        # and then one of one; track 2 starts with two (a run of its own, not
+        # joined to track 1's last) and holds a 9 px loss that is left out.
+        errors = {1: [0.5, 2.5, 2.5, 2.5, 0.5, 1.5, 3.5], 2: [2.5, 2.5, 0.5, 9.0, 0.5]}
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            rows_t, rows_g = [], []
+            for fid, es in errors.items():
+                for k, e in enumerate(es):
+                    t = 0.01 * k
+                    rows_g.append((fid, t, 100.0 + k, 50.0))
+                    rows_t.append((fid, t, 100.0 + k + e, 50.0))
+            write(tracks, rows_t)
+            write(truth, rows_g)
+            r = run(tracks, truth, "--off-px", "2", "--off-run", "2")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            # 11 points kept: beyond 1 px 7 (63.6 %), beyond 2 px 6 (54.5 %),
+            # beyond 3 px 1 (9.1 %); runs beyond 2 px: 3, 1 and 2 points,
+            # two of at least 2 points, holding 5.
+            self.assertIn("points beyond 1 / 2 / 3 px: 63.6 % / 54.5 % / 9.1 %", r.stdout)
+            self.assertIn("runs beyond 2 px: 3; 2 of at least 2 points, holding 5 points", r.stdout)
+
+    def test_a_loss_left_out_does_not_split_a_run(self):
+        # The 9 px point (past --max-error) is left out, as everywhere else
+        # in the script: the off points on either side are consecutive kept
+        # points and make one run.
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            es = [2.5, 9.0, 2.5, 0.5]
+            write(truth, [(1, 0.01 * k, 10.0, 10.0) for k in range(len(es))])
+            write(tracks, [(1, 0.01 * k, 10.0 + e, 10.0) for k, e in enumerate(es)])
+            r = run(tracks, truth, "--off-run", "2")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("runs beyond 2 px: 1; 1 of at least 2 points, holding 2 points", r.stdout)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,7 +1,9 @@
 // `evio track <sequence> --frontend eklt|klt|haste [--image-source frames|reconstructed]
-//  [--config file] [--set key=value] -o tracks.txt`: runs a feature-tracking
-// frontend over a sequence folder and writes its tracks (id t x y), with the
-// resolved configuration beside them (<output>.yaml).
+//  [--config file] [--set key=value] [--noise] -o tracks.txt`: runs a
+// feature-tracking frontend over a sequence folder and writes its tracks
+// (id t x y), with the resolved configuration beside them (<output>.yaml)
+// and, with --noise, what the tracker stated with each point
+// (<output>.noise.txt: id t quality cov_xx cov_xy cov_yy, px²).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -10,11 +12,36 @@
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/config.h"
 #include "evio/core/io/staged_folder.h"
+#include "evio/core/io/text_scanner.h"
 #include "evio/core/io/tracks_txt.h"
 #include "evio/experiments/track_sequence.h"
 #include "progress_line.h"
 
 namespace evio::apps {
+namespace {
+
+/// id t quality cov_xx cov_xy cov_yy, one line per sample, the stamps
+/// written as in the tracks file so the two join on (id, t).
+std::string noiseText(const experiments::TrackSequenceResult& result, const std::string& tracks_file) {
+  std::string out = "# what the tracker stated with each point of " + tracks_file +
+                    "\n# quality in [0, 1]; covariance of the position, px^2 (0 0 0: not stated)\n"
+                    "# id t quality cov_xx cov_xy cov_yy\n";
+  for (std::size_t k = 0; k < result.samples.size(); ++k) {
+    const io::TrackSample& s = result.samples[k];
+    const experiments::TrackSampleNoise& n = result.noise[k];
+    io::appendInt(out, s.id);
+    out.push_back(' ');
+    io::appendSeconds(out, s.t_ns);
+    for (const double v : {n.quality, n.cov_px(0, 0), n.cov_px(0, 1), n.cov_px(1, 1)}) {
+      out.push_back(' ');
+      io::appendDouble(out, v);
+    }
+    out.push_back('\n');
+  }
+  return out;
+}
+
+}  // namespace
 
 void addTrackCommand(CLI::App& app) {
   struct Args {
@@ -24,6 +51,7 @@ void addTrackCommand(CLI::App& app) {
     std::string config;
     std::vector<std::string> overrides;
     std::string output;
+    bool noise = false;
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
@@ -36,6 +64,9 @@ void addTrackCommand(CLI::App& app) {
   cmd->add_option("--config", args->config, "frontend options YAML (estimator FrontendOptions at the root)");
   cmd->add_option("--set", args->overrides, "override an option: eklt.patch_size_px=17 (repeatable)");
   cmd->add_option("-o,--output", args->output, "tracks file to write (id t x y)")->required();
+  cmd->add_flag("--noise", args->noise,
+                "also write <output>.noise.txt: each point's quality and position covariance (id t quality cov_xx "
+                "cov_xy cov_yy, px^2)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress line or summary");
   cmd->callback([args] {
     io::requireNotStaging(args->folder);
@@ -57,6 +88,11 @@ void addTrackCommand(CLI::App& app) {
                         {"evio track " + args->folder + " (" + options.tracker + ", " + options.image_source + ")",
                          "pixels of camera " + result.camera_name, "id t x y"});
     io::writeFileAtomic(staged.path(args->output + ".yaml"), config::toYaml(result.options));
+    const std::string noise_file = args->output + ".noise.txt";
+    if (args->noise)
+      io::writeFileAtomic(staged.path(noise_file), noiseText(result, args->output));
+    else
+      staged.drop(noise_file);  // an older run's noise would not belong to these tracks
     staged.publish();
     if (!args->quiet)
       std::printf("%llu tracks, %zu samples; %llu events (%llu after filters), %llu frames; %.2f s in the frontend "

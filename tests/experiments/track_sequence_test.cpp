@@ -2,11 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <map>
 
 #include "evio/core/io/calib_txt.h"
 #include "evio/core/io/events_txt.h"
 #include "evio/core/io/images_txt.h"
+#include "evio/estimator/frontend/eklt_cost.h"
 #include "evio/experiments/track_metrics.h"
 #include "synthetic_events.h"
 #include "temp_dir.h"
@@ -69,6 +71,45 @@ TEST(TrackSequence, EkltAndKltTrackASyntheticSequence) {
     EXPECT_LT(m.mean_error_px, 0.3) << tracker;
     EXPECT_GT(m.mean_feature_age_s, 0.05) << tracker;
   }
+}
+
+// Each sample comes with what its tracker stated: EKLT its quality and a
+// covariance no smaller than its floor, which with a reference cost grows as
+// σ_min · cost / ref for the worse fits; KLT states none.
+TEST(TrackSequence, EachSampleCarriesItsTrackersQualityAndCovariance) {
+  SyntheticSequence seq;
+  for (const double cost_ref : {0.0, 0.01}) {
+    estimator::FrontendOptions o;
+    o.eklt.batch_contrast_threshold = 0.02;
+    o.eklt.batch_max_events = 5000;
+    o.eklt.max_features = 10;
+    o.eklt.min_features = 5;
+    o.eklt.harris_quality_level = 0.05;
+    o.eklt.position_sigma_cost_ref = cost_ref;
+    const TrackSequenceResult r = trackSequence(seq.folder(), o);
+    ASSERT_EQ(r.noise.size(), r.samples.size());
+    int stated = 0, raised = 0;
+    for (const TrackSampleNoise& n : r.noise) {
+      EXPECT_GE(n.quality, 0.0);
+      EXPECT_LE(n.quality, 1.0);
+      if (n.cov_px.isZero()) continue;  // new and bootstrapped points: no batch, no covariance
+      ++stated;
+      const double floor =
+          std::min(estimator::ekltSigmaFloor(2.0 * (1.0 - n.quality), o.eklt.position_sigma_min_px, cost_ref),
+                   o.eklt.position_sigma_max_px);
+      const Eigen::SelfAdjointEigenSolver<Mat2> eig(n.cov_px);
+      EXPECT_GE(eig.eigenvalues().minCoeff(), floor * floor * (1.0 - 1e-9));
+      EXPECT_LE(eig.eigenvalues().maxCoeff(), o.eklt.position_sigma_max_px * o.eklt.position_sigma_max_px * (1.0 + 1e-9));
+      if (floor > o.eklt.position_sigma_min_px) ++raised;
+    }
+    EXPECT_GT(stated, 20) << "EKLT states a covariance with each point it solves for (53 here)";
+    if (cost_ref > 0.0) EXPECT_GT(raised, 0) << "some fits are worse than a cost of 0.01";
+  }
+  estimator::FrontendOptions klt;
+  klt.tracker = "klt";
+  const TrackSequenceResult r = trackSequence(seq.folder(), klt);
+  ASSERT_EQ(r.noise.size(), r.samples.size());
+  for (const TrackSampleNoise& n : r.noise) EXPECT_TRUE(n.cov_px.isZero());
 }
 
 // EKLT on frames reconstructed from events fused with the sensor frames

@@ -45,6 +45,7 @@ void EkltOptions::validate() const {
   requireInRange("max_batch_shift_px", max_batch_shift_px, 1e-3, 1000.0);
   requireNonNegative("lost_border_px", lost_border_px);
   requireInRange("position_sigma_min_px", position_sigma_min_px, 1e-3, 100.0);
+  requireInRange("position_sigma_cost_ref", position_sigma_cost_ref, 0.0, 2.0);  // the cost lies in [0, 2]
   requireField(position_sigma_max_px >= position_sigma_min_px && position_sigma_max_px <= 100.0,
                "position_sigma_max_px", "must be in [position_sigma_min_px, 100]");
   requireInRange("error_time_s", error_time_s, 0.0, 60.0);
@@ -414,8 +415,10 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
     EkltEvaluation at_solution;
     at_solution.cost = sol.cost;
     at_solution.jtj = sol.jtj;
-    point.cov_px = ekltPositionCovariance(at_solution, sol.p, s.x0, options_.patch_size_px,
-                                          options_.position_sigma_min_px, options_.position_sigma_max_px);
+    const double sigma_floor =
+        ekltSigmaFloor(sol.cost, options_.position_sigma_min_px, options_.position_sigma_cost_ref);
+    point.cov_px = ekltPositionCovariance(at_solution, sol.p, s.x0, options_.patch_size_px, sigma_floor,
+                                          options_.position_sigma_max_px);
   }
   part.points.push_back(ChunkPoint{event_index, index, point});
   resetPatch(s);

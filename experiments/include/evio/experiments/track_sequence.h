@@ -14,8 +14,15 @@
 
 namespace evio::experiments {
 
+/// What the tracker stated with one sample besides its position.
+struct TrackSampleNoise {
+  double quality = 1.0;         ///< tracking quality in [0, 1] (EKLT: 1 − cost/2; KLT, HASTE: 1)
+  Mat2 cov_px = Mat2::Zero();   ///< covariance of the position, px² (zero: not stated)
+};
+
 struct TrackSequenceResult {
   std::vector<io::TrackSample> samples;  ///< new and tracked points, in production order
+  std::vector<TrackSampleNoise> noise;   ///< sample by sample, what the tracker stated with it
   std::uint64_t events = 0;              ///< events read
   std::uint64_t events_kept = 0;         ///< after the pre-filters
   std::uint64_t frames = 0;              ///< sensor frames read

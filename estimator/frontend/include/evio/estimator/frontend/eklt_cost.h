@@ -60,6 +60,15 @@ bool ekltResiduals(const EkltBatch& batch, const Vec4& p, VecX* r, MatX* d_r_d_p
 /// sends to the template point x0, c = c_acc + R(θ)ᵀ (x0 − t).
 Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const Vec2& x0);
 
+/// The floor of the position σ for a solution with this cost (px): σ_min,
+/// raised in proportion for fits worse than the reference cost,
+///   σ_floor = σ_min · max(1, cost / cost_ref)
+/// (cost_ref ≤ 0: σ_min). Measured on EKLT's points against their truth (the
+/// lag removed; poster_6dof and mars_yard_circle, seed 101), the error's
+/// variance per axis above the median cost grows as the square of the cost
+/// (README "A covariance floor that follows the fit").
+double ekltSigmaFloor(double cost, double sigma_min_px, double cost_ref);
+
 /// The covariance of the feature position ekltFeaturePosition(p, c_acc, x0)
 /// at a minimum p of the cost (docs/algorithms.md#eklt-measurement-covariance):
 /// the Gauss–Newton (Laplace) covariance of the least-squares estimate,

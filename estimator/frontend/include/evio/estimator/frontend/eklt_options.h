@@ -96,6 +96,10 @@ struct EkltOptions {
   /// (README "Consistency"): 0.2 px gives ANEES in the thousands, 1 px 6.9,
   /// 2 px 5.1 (with repeats dropped 4.4; bounds [3.36, 9.40]).
   double position_sigma_min_px = 2.0;
+  /// Raise the floor in proportion for fits worse than this cost (eklt_cost.h
+  /// ekltSigmaFloor: σ_min · max(1, cost / ref)); 0: the same floor for
+  /// every point.
+  double position_sigma_cost_ref = 0.0;
   /// Cap of the position σ, px: the directions the patch does not constrain
   /// (along a straight edge) get this σ (the former fixed σ_img, 5 px).
   double position_sigma_max_px = 5.0;
@@ -141,6 +145,7 @@ struct EkltOptions {
     v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
     v("position_covariance", position_covariance, "attach the position covariance from the cost curvature");
     v("position_sigma_min_px", position_sigma_min_px, "floor of the position sigma, px");
+    v("position_sigma_cost_ref", position_sigma_cost_ref, "cost above which the floor grows (0: fixed floor)");
     v("position_sigma_max_px", position_sigma_max_px, "cap of the position sigma, px");
     v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
     v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");

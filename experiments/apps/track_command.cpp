@@ -12,36 +12,12 @@
 #include "evio/core/io/atomic_file.h"
 #include "evio/core/io/config.h"
 #include "evio/core/io/staged_folder.h"
-#include "evio/core/io/text_scanner.h"
+#include "evio/core/io/track_noise_txt.h"
 #include "evio/core/io/tracks_txt.h"
 #include "evio/experiments/track_sequence.h"
 #include "progress_line.h"
 
 namespace evio::apps {
-namespace {
-
-/// id t quality cov_xx cov_xy cov_yy, one line per sample, the stamps
-/// written as in the tracks file so the two join on (id, t).
-std::string noiseText(const experiments::TrackSequenceResult& result, const std::string& tracks_file) {
-  std::string out = "# what the tracker stated with each point of " + tracks_file +
-                    "\n# quality in [0, 1]; covariance of the position, px^2 (0 0 0: not stated)\n"
-                    "# id t quality cov_xx cov_xy cov_yy\n";
-  for (std::size_t k = 0; k < result.samples.size(); ++k) {
-    const io::TrackSample& s = result.samples[k];
-    const experiments::TrackSampleNoise& n = result.noise[k];
-    io::appendInt(out, s.id);
-    out.push_back(' ');
-    io::appendSeconds(out, s.t_ns);
-    for (const double v : {n.quality, n.cov_px(0, 0), n.cov_px(0, 1), n.cov_px(1, 1)}) {
-      out.push_back(' ');
-      io::appendDouble(out, v);
-    }
-    out.push_back('\n');
-  }
-  return out;
-}
-
-}  // namespace
 
 void addTrackCommand(CLI::App& app) {
   struct Args {
@@ -89,10 +65,14 @@ void addTrackCommand(CLI::App& app) {
                          "pixels of camera " + result.camera_name, "id t x y"});
     io::writeFileAtomic(staged.path(args->output + ".yaml"), config::toYaml(result.options));
     const std::string noise_file = args->output + ".noise.txt";
-    if (args->noise)
-      io::writeFileAtomic(staged.path(noise_file), noiseText(result, args->output));
-    else
+    if (args->noise) {
+      io::writeTrackNoiseText(staged.path(noise_file), result.noise,
+                              {"what the tracker stated with each point of " + args->output,
+                               "quality in [0, 1]; covariance of the position, px^2 (0 0 0: not stated)",
+                               "id t quality cov_xx cov_xy cov_yy"});
+    } else {
       staged.drop(noise_file);  // an older run's noise would not belong to these tracks
+    }
     staged.publish();
     if (!args->quiet)
       std::printf("%llu tracks, %zu samples; %llu events (%llu after filters), %llu frames; %.2f s in the frontend "

@@ -5,44 +5,57 @@ of its quality.
 Input: a tracks file and its noise sidecar from `evio track --noise`
 (TRACKS and TRACKS.noise.txt: id t quality cov_xx cov_xy cov_yy, px²), and
 the same tracks' true positions from `evio evaluate-tracks ... --truth-output`
-(id t x y). Points are joined on (id, t); points without a truth, without a
-stated covariance, the first point of each track (the detection, exact by
-construction) and points with |e| above --max-error px (gross losses) are
-left out.
+(id t x y). Points are joined on (id, t). Left out: points without a truth or
+without a stated covariance; the first and last truth point of each track
+(the first is the detection, exact by construction; the velocity below needs
+a neighbour on both sides); points with |e| above --max-error px (gross
+losses).
 
 The error is e = tracked − true, px. The filter compensates the tracker's
 lag along the motion (a + τ|v|, README "Tracker lag"), so with --lag-model
-the least-squares a and τ of lag = −e·v̂ against the true image speed |v|
-are fitted over the points and a + τ|v| is added back along v̂ before any
-figure (v from the central difference of the true positions). Printed per
-quality band:
+the lag is fitted as experiments/scripts/track_lag.py fits it (lag = −e·v̂
+against the true image speed |v|, least squares over the points faster than
+--min-speed px/s) and a + τ|v| is added back along v̂ of every point before
+any figure (v: the central difference of the true positions). Printed, over
+all points and per quality band (points below the first band edge count
+only in the first line):
 
   * points; share with |e| beyond 2 px;
   * the error's mean square per axis, (ex² + ey²)/2, px²;
   * the mean stated variance per axis, (cov_xx + cov_yy)/2, px²;
   * the mean NEES per degree of freedom, eᵀ Σ⁻¹ e / 2, which is 1 when the
-    stated covariance is the error's.
+    stated covariance is the error's;
 
-and the least-squares fit, weighted by the bands' point counts, of the mean
-square per axis against the mean cost (2 (1 − quality)) of each band:
-ms ≈ v0 + k · cost.
+and two least-squares fits of the bands' mean squares against their mean
+cost (2 (1 − quality)), each band weighted by its point count:
+ms ≈ v0 + k · cost and ms ≈ v0 + k · cost².
 
 Usage: track_noise_stats.py TRACKS TRUTH [--bands 0.6,0.7,0.8,0.85,0.9,0.95,1.0001]
-       [--max-error 5] [--lag-model]
+       [--max-error 5] [--lag-model] [--min-speed 50]
 """
 import argparse
+import os
 import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plots"))
+from plot_tracks import load_tracks  # noqa: E402  (the project's reader of `id t x y` files)
+from track_lag import fitLag  # noqa: E402  (the lag model's fit, as the tracker-lag figures use it)
 
-def read_rows(path, columns):
-    rows = np.loadtxt(path, comments="#", ndmin=2)
-    if rows.size == 0:
-        return np.zeros((0, columns))
-    if rows.shape[1] != columns:
-        sys.exit(f"{path}: expected {columns} columns, found {rows.shape[1]}")
-    return rows
+
+def load_noise(path):
+    """Rows (id, t, quality, cov_xx, cov_xy, cov_yy) of an `evio track --noise` sidecar."""
+    try:
+        data = np.loadtxt(path, comments="#", ndmin=2)
+    except (OSError, ValueError) as e:
+        sys.exit(f"track_noise_stats: cannot read {path}: {e}")
+    if data.size == 0:
+        return np.zeros((0, 6))
+    if data.shape[1] != 6:
+        sys.exit(f"track_noise_stats: {path}: expected 6 columns 'id t quality cov_xx cov_xy cov_yy', "
+                 f"got {data.shape[1]}")
+    return data
 
 
 def keyed(rows):
@@ -53,9 +66,9 @@ def keyed(rows):
 def joined(tracks_path, truth_path):
     """Arrays of the joined points: e[n,2], v[n,2] (true image velocity,
     px/s), quality[n], cov[n,2,2]."""
-    tracks = keyed(read_rows(tracks_path, 4))
-    noise = keyed(read_rows(tracks_path + ".noise.txt", 6))
-    truth_rows = read_rows(truth_path, 4)
+    tracks = keyed(load_tracks(tracks_path))
+    noise = keyed(load_noise(tracks_path + ".noise.txt"))
+    truth_rows = load_tracks(truth_path)
     e, v, q, cov = [], [], [], []
     for fid in np.unique(truth_rows[:, 0]).astype(int):
         g = truth_rows[truth_rows[:, 0] == fid]
@@ -74,16 +87,19 @@ def joined(tracks_path, truth_path):
     return np.array(e).reshape(-1, 2), np.array(v).reshape(-1, 2), np.array(q), np.array(cov).reshape(-1, 2, 2)
 
 
-def remove_lag(e, v):
-    """e with the fitted lag a + τ|v| added back along the motion; (a, τ)."""
+def remove_lag(e, v, min_speed):
+    """e with the fitted lag a + τ|v| added back along the motion; (a, τ).
+    The fit takes the points faster than min_speed px/s, as track_lag.py."""
     speed = np.linalg.norm(v, axis=1)
-    moving = speed > 1e-9
+    moving = speed > 0.0
     u = np.zeros_like(v)
     u[moving] = v[moving] / speed[moving, None]
     lag = -np.sum(e * u, axis=1)
-    A = np.stack([np.ones(moving.sum()), speed[moving]], axis=1)
-    (a, tau), *_ = np.linalg.lstsq(A, lag[moving], rcond=None)
-    return e + (a + tau * speed)[:, None] * u, a, tau
+    fast = speed >= min_speed
+    if fast.sum() < 2:
+        sys.exit(f"track_noise_stats: fewer than two points faster than {min_speed:g} px/s to fit the lag")
+    a, tau = fitLag(list(zip(speed[fast], lag[fast])))
+    return e + ((a + tau * speed) * moving)[:, None] * u, a, tau
 
 
 def main():
@@ -93,6 +109,7 @@ def main():
     ap.add_argument("--bands", default="0.6,0.7,0.8,0.85,0.9,0.95,1.0001", help="quality band edges")
     ap.add_argument("--max-error", type=float, default=5.0, help="leave out points with |e| above this, px")
     ap.add_argument("--lag-model", action="store_true", help="remove the fitted along-motion lag a + tau |v| first")
+    ap.add_argument("--min-speed", type=float, default=50.0, help="px/s: the lag fit's points (as track_lag.py)")
     a = ap.parse_args()
     e, v, q, cov = joined(a.tracks, a.truth)
     keep = np.linalg.norm(e, axis=1) <= a.max_error
@@ -100,7 +117,7 @@ def main():
     if len(e) == 0:
         sys.exit("no point has both a truth and a stated covariance")
     if a.lag_model:
-        e, lag_a, lag_tau = remove_lag(e, v)
+        e, lag_a, lag_tau = remove_lag(e, v, a.min_speed)
         print(f"lag removed: a = {lag_a:.3f} px, tau = {lag_tau * 1e3:.2f} ms")
     nees = np.einsum("ni,nij,nj->n", e, np.linalg.inv(cov), e) / 2
     print(f"points {len(e)}; mean square per axis {np.mean(e ** 2):.3f} px², "
@@ -114,16 +131,18 @@ def main():
             continue
         band_ms = float(np.mean(e[m] ** 2))
         stated = float(np.mean((cov[m, 0, 0] + cov[m, 1, 1]) / 2))
-        print(f"[{lo:.2f}, {min(hi, 1):.2f})  {int(m.sum()):8d}  {100 * np.mean(np.linalg.norm(e[m], axis=1) > 2):9.1f} %"
+        print(f"[{lo:.2f}, {min(hi, 1):.2f}{')' if hi <= 1 else ']'}  {int(m.sum()):8d}  {100 * np.mean(np.linalg.norm(e[m], axis=1) > 2):9.1f} %"
               f"  {band_ms:11.3f}  {stated:6.3f}  {np.mean(nees[m]):8.2f}")
         cost.append(float(np.mean(2 * (1 - q[m]))))
         ms.append(band_ms)
         weight.append(float(m.sum()))
     if len(ms) >= 2:
-        w = np.sqrt(np.array(weight))
-        A = np.stack([np.ones(len(ms)), np.array(cost)], axis=1)
-        (v0, k), *_ = np.linalg.lstsq(A * w[:, None], np.array(ms) * w, rcond=None)
-        print(f"mean square per axis ≈ {v0:.3f} px² + {k:.3f} px² · cost")
+        w = np.sqrt(np.array(weight))  # rows scaled by √n: each band weighs by its point count
+        for name, x in (("cost", np.array(cost)), ("cost²", np.array(cost) ** 2)):
+            A = np.stack([np.ones(len(ms)), x], axis=1)
+            (v0, k), *_ = np.linalg.lstsq(A * w[:, None], np.array(ms) * w, rcond=None)
+            rms = np.sqrt(np.average((A @ [v0, k] - np.array(ms)) ** 2, weights=weight))
+            print(f"mean square per axis ≈ {v0:.3f} px² + {k:.3f} px² · {name}  (weighted rms misfit {rms:.3f} px²)")
 
 
 if __name__ == "__main__":

@@ -176,7 +176,7 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
         it->second = p.t_ns;
       }
       result.samples.push_back(io::TrackSample{p.feature_id, p.t_ns, p.uv});
-      result.noise.push_back(TrackSampleNoise{p.quality, p.cov_px});
+      result.noise.push_back(io::TrackNoiseSample{p.feature_id, p.t_ns, p.quality, p.cov_px});
     }
   };
   const auto feedImuUntil = [&](TimeNs t) {

@@ -291,14 +291,15 @@ TEST(EkltCost, PositionCovarianceOfAStraightEdgeIsTheCurvatureAcrossAndTheCapAlo
   EXPECT_NEAR(cov4(0, 0) / cov1(0, 0), 4.0, 1e-3);
 }
 
-// The floor is σ_min up to the reference cost and grows in proportion to the
-// cost beyond it; a reference of 0 leaves it fixed.
+// The floor is σ_min up to the reference cost, grows in proportion to the
+// cost beyond it and stops at the cap; a reference of 0 leaves it fixed.
 TEST(EkltCost, SigmaFloorGrowsInProportionToTheCostPastTheReference) {
-  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.9, 2.0, 0.0), 2.0);
-  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.1, 2.0, 0.25), 2.0);
-  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.25, 2.0, 0.25), 2.0);
-  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.5, 2.0, 0.25), 4.0);
-  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.75, 2.0, 0.25), 6.0);
+  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.9, 2.0, 5.0, 0.0), 2.0);
+  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.1, 2.0, 5.0, 0.25), 2.0);
+  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.25, 2.0, 5.0, 0.25), 2.0);
+  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.5, 2.0, 5.0, 0.25), 4.0);
+  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.55, 2.0, 5.0, 0.25), 4.4);
+  EXPECT_DOUBLE_EQ(ekltSigmaFloor(0.75, 2.0, 5.0, 0.25), 5.0);  // 6 px, capped
 }
 
 // The hand-written LM and the Ceres reference reach the same solutions on

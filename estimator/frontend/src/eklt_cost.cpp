@@ -349,9 +349,9 @@ Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const V
   return accumulation_centre + Vec2(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
 }
 
-double ekltSigmaFloor(double cost, double sigma_min_px, double cost_ref) {
+double ekltSigmaFloor(double cost, double sigma_min_px, double sigma_max_px, double cost_ref) {
   if (!(cost_ref > 0.0)) return sigma_min_px;
-  return sigma_min_px * std::max(1.0, cost / cost_ref);
+  return std::min(sigma_min_px * std::max(1.0, cost / cost_ref), sigma_max_px);
 }
 
 Mat2 ekltPositionCovariance(const EkltEvaluation& eval, const Vec4& p, const Vec2& x0, int patch_size,

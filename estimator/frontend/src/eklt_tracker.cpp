@@ -415,8 +415,8 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
     EkltEvaluation at_solution;
     at_solution.cost = sol.cost;
     at_solution.jtj = sol.jtj;
-    const double sigma_floor =
-        ekltSigmaFloor(sol.cost, options_.position_sigma_min_px, options_.position_sigma_cost_ref);
+    const double sigma_floor = ekltSigmaFloor(sol.cost, options_.position_sigma_min_px,
+                                              options_.position_sigma_max_px, options_.position_sigma_cost_ref);
     point.cov_px = ekltPositionCovariance(at_solution, sol.p, s.x0, options_.patch_size_px, sigma_floor,
                                           options_.position_sigma_max_px);
   }

@@ -9,20 +9,15 @@
 #include <string>
 #include <vector>
 
+#include "evio/core/io/track_noise_txt.h"
 #include "evio/core/io/tracks_txt.h"
 #include "evio/estimator/frontend/frontend.h"
 
 namespace evio::experiments {
 
-/// What the tracker stated with one sample besides its position.
-struct TrackSampleNoise {
-  double quality = 1.0;         ///< tracking quality in [0, 1] (EKLT: 1 − cost/2; KLT, HASTE: 1)
-  Mat2 cov_px = Mat2::Zero();   ///< covariance of the position, px² (zero: not stated)
-};
-
 struct TrackSequenceResult {
   std::vector<io::TrackSample> samples;  ///< new and tracked points, in production order
-  std::vector<TrackSampleNoise> noise;   ///< sample by sample, what the tracker stated with it
+  std::vector<io::TrackNoiseSample> noise;  ///< sample by sample, its quality and covariance as the tracker stated them
   std::uint64_t events = 0;              ///< events read
   std::uint64_t events_kept = 0;         ///< after the pre-filters
   std::uint64_t frames = 0;              ///< sensor frames read

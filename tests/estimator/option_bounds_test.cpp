@@ -52,7 +52,7 @@ const std::vector<Bound>& bounds() {
       {"frontend.eklt.error_time_s", "60", "1e9"},
       {"frontend.klt.error_time_s", "60", "1e9"},
       {"frontend.haste.error_time_s", "60", "1e9"},
-      {"frontend.eklt.position_sigma_cost_ref", "2", "3"},  // the cost lies in [0, 2]
+      {"frontend.eklt.position_sigma_cost_ref", "2", "1e9"},  // the cost lies in [0, 2]
       {"backend.static_window_s", "3600", "1e12"},
       {"frontend.eklt.max_features", "10000", "100000000"},
       {"frontend.eklt.harris_block_size", "101", "1000000"},

@@ -24,17 +24,26 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def load_tracks(path):
-    """Rows (id, t, x, y); exits with a clear message on bad input."""
+def load_table(path, names):
+    """Rows of a whitespace table with the columns `names` (one string, the
+    names separated by spaces; '#' starts a comment); exits with a clear
+    message, named after the running script, on bad input."""
+    script = os.path.basename(sys.argv[0]) or "evio"
+    columns = len(names.split())
     try:
         data = np.loadtxt(path, comments="#", ndmin=2)
     except (OSError, ValueError) as e:
-        sys.exit(f"plot_tracks: cannot read {path}: {e}")
+        sys.exit(f"{script}: cannot read {path}: {e}")
     if data.size == 0:
-        return np.zeros((0, 4))
-    if data.shape[1] != 4:
-        sys.exit(f"plot_tracks: {path}: expected 4 columns 'id t x y', got {data.shape[1]}")
+        return np.zeros((0, columns))
+    if data.shape[1] != columns:
+        sys.exit(f"{script}: {path}: expected {columns} columns '{names}', got {data.shape[1]}")
     return data
+
+
+def load_tracks(path):
+    """Rows (id, t, x, y) of an `evio track` file."""
+    return load_table(path, "id t x y")
 
 
 def load_frames(folder):

@@ -40,22 +40,8 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plots"))
-from plot_tracks import load_tracks  # noqa: E402  (the project's reader of `id t x y` files)
+from plot_tracks import load_table, load_tracks  # noqa: E402  (the project's readers of whitespace tables)
 from track_lag import fitLag  # noqa: E402  (the lag model's fit, as the tracker-lag figures use it)
-
-
-def load_noise(path):
-    """Rows (id, t, quality, cov_xx, cov_xy, cov_yy) of an `evio track --noise` sidecar."""
-    try:
-        data = np.loadtxt(path, comments="#", ndmin=2)
-    except (OSError, ValueError) as e:
-        sys.exit(f"track_noise_stats: cannot read {path}: {e}")
-    if data.size == 0:
-        return np.zeros((0, 6))
-    if data.shape[1] != 6:
-        sys.exit(f"track_noise_stats: {path}: expected 6 columns 'id t quality cov_xx cov_xy cov_yy', "
-                 f"got {data.shape[1]}")
-    return data
 
 
 def keyed(rows):
@@ -67,7 +53,7 @@ def joined(tracks_path, truth_path):
     """Arrays of the joined points: e[n,2], v[n,2] (true image velocity,
     px/s), quality[n], cov[n,2,2]."""
     tracks = keyed(load_tracks(tracks_path))
-    noise = keyed(load_noise(tracks_path + ".noise.txt"))
+    noise = keyed(load_table(tracks_path + ".noise.txt", "id t quality cov_xx cov_xy cov_yy"))
     truth_rows = load_tracks(truth_path)
     e, v, q, cov = [], [], [], []
     for fid in np.unique(truth_rows[:, 0]).astype(int):

@@ -243,6 +243,41 @@ TEST(Frontend, TrackPointsStateTheirTrackersErrorTimeConstant) {
   }
 }
 
+// KLT states the σ of its section (position_sigma_px) as each point's
+// covariance σ² I; without it a point states none (the backend's σ_img).
+// EKLT keeps the covariance of its own fit whatever KLT's section says.
+TEST(Frontend, KltPointsStateTheirSectionsPositionSigma) {
+  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+  cv::Mat image(180, 240, CV_8UC1, cv::Scalar(20));
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 5; ++c) image(cv::Rect(30 + 40 * c, 25 + 35 * r, 16, 16)).setTo(cv::Scalar(220));
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);
+  const auto pointsOf = [&](const std::string& tracker, double klt_sigma_px) {
+    FrontendOptions options;
+    options.tracker = tracker;
+    options.klt.position_sigma_px = klt_sigma_px;
+    options.haste.position_sigma_px = 7.0;  // another tracker's section: not used
+    Frontend frontend(options, cam);
+    frontend.addFrame(secondsToNs(0.1), image);
+    frontend.addFrame(secondsToNs(0.15), image);
+    TrackPoints points;
+    frontend.drainTrackPoints(points);
+    return points;
+  };
+  const TrackPoints stated = pointsOf("klt", 3.0);
+  ASSERT_FALSE(stated.empty());
+  for (const TrackPoint& p : stated) EXPECT_EQ(p.cov_px, Mat2(9.0 * Mat2::Identity()));
+  const TrackPoints unstated = pointsOf("klt", 0.0);
+  ASSERT_EQ(unstated.size(), stated.size());
+  for (std::size_t i = 0; i < unstated.size(); ++i) {
+    EXPECT_EQ(unstated[i].cov_px, Mat2::Zero());
+    EXPECT_EQ(unstated[i].uv, stated[i].uv);  // the σ changes what is stated, not the track
+  }
+  const TrackPoints eklt = pointsOf("eklt", 3.0);
+  ASSERT_FALSE(eklt.empty());
+  for (const TrackPoint& p : eklt) EXPECT_NE(p.cov_px, Mat2(9.0 * Mat2::Identity()));
+}
+
 TEST(FrontendOptions, DefaultsRoundTripThroughYamlAndOverridesAreChecked) {
   const FrontendOptions defaults;
   FrontendOptions back;

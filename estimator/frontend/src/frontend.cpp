@@ -55,6 +55,9 @@ Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::op
   error_time_s_ = options_.tracker == "eklt"    ? options_.eklt.error_time_s
                   : options_.tracker == "haste" ? options_.haste.error_time_s
                                                 : options_.klt.error_time_s;
+  position_sigma_px_ = options_.tracker == "haste" ? options_.haste.position_sigma_px
+                       : options_.tracker == "klt" ? options_.klt.position_sigma_px
+                                                   : 0.0;
   if (options_.track_lag.estimate && options_.tracker != "klt")
     probe_ = std::make_unique<FrameLagProbe>(options_.track_lag);
 }
@@ -90,19 +93,23 @@ void Frontend::addEventChunks(const EventArray& events, const std::vector<std::s
   events_ += chunk_ends.empty() ? 0 : chunk_ends.back();
   const std::size_t begin = out.size();
   tracker_->addEventChunks(events, chunk_ends, out, point_ends);
-  stateErrorTime(out, begin);
+  stateNoise(out, begin);
   if (probe_) probe_->observe(out, begin);
 }
 
 void Frontend::drainTrackPoints(TrackPoints& out) {
   const std::size_t begin = out.size();
   tracker_->drainTrackPoints(out);
-  stateErrorTime(out, begin);
+  stateNoise(out, begin);
   if (probe_) probe_->observe(out, begin);
 }
 
-void Frontend::stateErrorTime(TrackPoints& points, std::size_t begin) const {
-  for (std::size_t i = begin; i < points.size(); ++i) points[i].error_time_s = error_time_s_;
+void Frontend::stateNoise(TrackPoints& points, std::size_t begin) const {
+  const Mat2 stated = position_sigma_px_ * position_sigma_px_ * Mat2::Identity();
+  for (std::size_t i = begin; i < points.size(); ++i) {
+    points[i].error_time_s = error_time_s_;
+    if (position_sigma_px_ > 0.0 && points[i].cov_px == Mat2::Zero()) points[i].cov_px = stated;
+  }
 }
 
 void Frontend::addFrame(TimeNs t_ns, const cv::Mat& image) {

@@ -39,6 +39,7 @@ void HasteOptions::validate() const {
   requireInRange("seed_timeout_s", seed_timeout_s, 1e-6, 1e6);
   requireInRange("lost_border_px", lost_border_px, 0.0, 1000.0);
   requireInRange("error_time_s", error_time_s, 0.0, 60.0);
+  requireInRange("position_sigma_px", position_sigma_px, 0.0, 100.0);
 }
 
 }  // namespace evio::estimator

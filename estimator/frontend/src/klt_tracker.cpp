@@ -23,6 +23,7 @@ void KltOptions::validate() const {
   requirePositive("ransac_threshold_px", ransac_threshold_px);
   requireField(ransac_confidence > 0.0 && ransac_confidence < 1.0, "ransac_confidence", "must be in (0, 1)");
   requireInRange("error_time_s", error_time_s, 0.0, 60.0);
+  requireInRange("position_sigma_px", position_sigma_px, 0.0, 100.0);
 }
 
 KltTracker::KltTracker(const KltOptions& options, const Camera& camera, std::optional<Pose> T_B_C)

@@ -89,7 +89,8 @@ class Frontend {
 
   /// Appends the track points since the last call (the lag probe sees them
   /// too), each stating the tracker's error time constant (error_time_s of
-  /// its options section).
+  /// its options section) and, where the tracker states no covariance of its
+  /// own, its section's position_sigma_px as σ² I (KLT and HASTE).
   void drainTrackPoints(TrackPoints& out);
   /// True when the events of several chunks may be tracked in one call:
   /// nothing but events changes the tracker between them (no reconstruction;
@@ -113,11 +114,12 @@ class Frontend {
   std::uint64_t numReconstructedFrames() const { return reconstructed_frames_; }
 
  private:
-  /// points[begin, end) take the tracker's error time constant.
-  void stateErrorTime(TrackPoints& points, std::size_t begin) const;
+  /// points[begin, end) take the tracker's error time constant and stated σ.
+  void stateNoise(TrackPoints& points, std::size_t begin) const;
 
   FrontendOptions options_;
-  double error_time_s_ = 0.0;  ///< the tracker's options' error_time_s
+  double error_time_s_ = 0.0;       ///< the tracker's options' error_time_s
+  double position_sigma_px_ = 0.0;  ///< KLT's or HASTE's position_sigma_px (EKLT states its own covariance)
   std::unique_ptr<FeatureTracker> tracker_;
   std::unique_ptr<ImageReconstructor> reconstructor_;
   std::unique_ptr<FrameLagProbe> probe_;

@@ -67,6 +67,9 @@ struct HasteOptions {
   /// Time constant of the track error stated with every point, s (0:
   /// independent; as EkltOptions::error_time_s).
   double error_time_s = 0.0;
+  /// σ of each point's position stated with every point, px per axis (0:
+  /// none, the backend's σ_img; as KltOptions::position_sigma_px).
+  double position_sigma_px = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -89,6 +92,7 @@ struct HasteOptions {
     v("one_point_per_window", one_point_per_window, "send a new state at most once per window time span");
     v("lost_border_px", lost_border_px, "lost this close to the image edge, px");
     v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
+    v("position_sigma_px", position_sigma_px, "position sigma stated with each point, px (0: none, the backend's sigma_img)");
   }
 
   void validate() const;

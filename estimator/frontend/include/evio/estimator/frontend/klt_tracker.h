@@ -46,6 +46,10 @@ struct KltOptions {
   /// Time constant of the track error stated with every point, s (0:
   /// independent; as EkltOptions::error_time_s).
   double error_time_s = 0.0;
+  /// σ of each point's position, px per axis, stated with every point as its
+  /// covariance σ² I (TrackPoint::cov_px); the backend then weighs the point
+  /// by it instead of its own σ_img. 0: none stated (σ_img).
+  double position_sigma_px = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -64,6 +68,7 @@ struct KltOptions {
     v("ransac_confidence", ransac_confidence, "RANSAC confidence");
     v("imu_prediction", imu_prediction, "start each Lucas-Kanade search at the gyro's prediction");
     v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
+    v("position_sigma_px", position_sigma_px, "position sigma stated with each point, px (0: none, the backend's sigma_img)");
   }
   void validate() const;
 };

@@ -53,6 +53,7 @@ const std::vector<Bound>& bounds() {
       {"frontend.klt.error_time_s", "60", "1e9"},
       {"frontend.haste.error_time_s", "60", "1e9"},
       {"frontend.klt.position_sigma_px", "100", "1e9"},
+      {"frontend.klt.backward_check_px", "1000", "1e9"},
       {"frontend.haste.position_sigma_px", "100", "1e9"},
       {"frontend.eklt.position_sigma_cost_ref", "2", "1e9"},  // the cost lies in [0, 2]
       {"backend.static_window_s", "3600", "1e12"},

@@ -24,6 +24,7 @@ void KltOptions::validate() const {
   requireField(ransac_confidence > 0.0 && ransac_confidence < 1.0, "ransac_confidence", "must be in (0, 1)");
   requireInRange("error_time_s", error_time_s, 0.0, 60.0);
   requireInRange("position_sigma_px", position_sigma_px, 0.0, 100.0);
+  requireInRange("backward_check_px", backward_check_px, 0.0, 1000.0);
 }
 
 KltTracker::KltTracker(const KltOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
@@ -71,13 +72,29 @@ void KltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
     for (const Vec2& p : points_) p0.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
     // Without a prediction p1 starts at p0, as OpenCV does by itself.
     std::vector<cv::Point2f> p1 = predictor_ ? searchStarts(t_ns) : p0;
+    const std::vector<cv::Point2f> starts = p1;
     std::vector<std::uint8_t> status;
     std::vector<float> err;
-    cv::calcOpticalFlowPyrLK(previous_, image8, p0, p1, status, err, cv::Size(options_.window_px, options_.window_px),
-                             options_.pyramid_levels - 1,
-                             cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.max_iterations,
-                                              options_.lk_epsilon),
+    const cv::Size window(options_.window_px, options_.window_px);
+    const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.max_iterations,
+                                options_.lk_epsilon);
+    cv::calcOpticalFlowPyrLK(previous_, image8, p0, p1, status, err, window, options_.pyramid_levels - 1, stop,
                              predictor_ ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+    if (options_.backward_check_px > 0.0) {
+      // Back from p1, started as far from it as the forward search started
+      // from p0 (at p1 itself without a prediction).
+      std::vector<cv::Point2f> back(p1.size());
+      for (std::size_t k = 0; k < p1.size(); ++k) back[k] = p1[k] - (starts[k] - p0[k]);
+      std::vector<std::uint8_t> back_status;
+      std::vector<float> back_err;
+      cv::calcOpticalFlowPyrLK(image8, previous_, p1, back, back_status, back_err, window, options_.pyramid_levels - 1,
+                               stop, cv::OPTFLOW_USE_INITIAL_FLOW);
+      const double max_sq = options_.backward_check_px * options_.backward_check_px;
+      for (std::size_t k = 0; k < p1.size(); ++k) {
+        const cv::Point2f d = back[k] - p0[k];
+        if (back_status[k] == 0 || !(d.x * d.x + d.y * d.y <= max_sq)) status[k] = 0;
+      }
+    }
     std::vector<bool> keep(points_.size(), false);
     std::vector<std::size_t> candidates;
     for (std::size_t k = 0; k < points_.size(); ++k) {

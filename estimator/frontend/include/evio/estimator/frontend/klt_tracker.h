@@ -43,6 +43,13 @@ struct KltOptions {
   double ransac_threshold_px = 0.6;  ///< epipolar distance, px of the undistorted image
   double ransac_confidence = 0.99;   ///< RANSAC confidence
   bool imu_prediction = false;       ///< start each search at the gyro's prediction (needs IMU and T_B_C)
+  /// Forward–backward check, px (0: off): Lucas–Kanade is run back from
+  /// each tracked point into the previous frame, started where the forward
+  /// search's start lay relative to the feature, and the point is lost when
+  /// it lands farther than this from where the feature was. A jump to a
+  /// wrong minimum (an exposure step between frames, a motion beyond the
+  /// pyramid) rarely leads back to its start.
+  double backward_check_px = 0.0;
   /// Time constant of the track error stated with every point, s (0:
   /// independent; as EkltOptions::error_time_s).
   double error_time_s = 0.0;
@@ -67,6 +74,7 @@ struct KltOptions {
     v("ransac_threshold_px", ransac_threshold_px, "RANSAC threshold, px of the undistorted image");
     v("ransac_confidence", ransac_confidence, "RANSAC confidence");
     v("imu_prediction", imu_prediction, "start each Lucas-Kanade search at the gyro's prediction");
+    v("backward_check_px", backward_check_px, "lose a point whose backward Lucas-Kanade lands farther than this from its start, px (0: off)");
     v("error_time_s", error_time_s, "time constant of the track error stated with each point, s (0: independent)");
     v("position_sigma_px", position_sigma_px, "position sigma stated with each point, px (0: none, the backend's sigma_img)");
   }

@@ -91,8 +91,9 @@ void KltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
                                stop, cv::OPTFLOW_USE_INITIAL_FLOW);
       const double max_sq = options_.backward_check_px * options_.backward_check_px;
       for (std::size_t k = 0; k < p1.size(); ++k) {
-        const cv::Point2f d = back[k] - p0[k];
-        if (back_status[k] == 0 || !(d.x * d.x + d.y * d.y <= max_sq)) status[k] = 0;
+        const double dx = static_cast<double>(back[k].x) - static_cast<double>(p0[k].x);
+        const double dy = static_cast<double>(back[k].y) - static_cast<double>(p0[k].y);
+        if (back_status[k] == 0 || !(dx * dx + dy * dy <= max_sq)) status[k] = 0;
       }
     }
     std::vector<bool> keep(points_.size(), false);

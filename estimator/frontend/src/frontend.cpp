@@ -44,20 +44,22 @@ FrontendOptions resolveSensorParameters(FrontendOptions options,
 Frontend::Frontend(const FrontendOptions& options, const Camera& camera, std::optional<Pose> T_B_C)
     : options_(options) {
   options_.validate();
-  if (options_.tracker == "eklt")
+  // The tracker, and what its section states with every point (EKLT states
+  // each point's covariance itself).
+  if (options_.tracker == "eklt") {
     tracker_ = std::make_unique<EkltTracker>(options_.eklt, camera, T_B_C, options_.threads);
-  else if (options_.tracker == "haste")
+    error_time_s_ = options_.eklt.error_time_s;
+  } else if (options_.tracker == "haste") {
     tracker_ = std::make_unique<HasteTracker>(options_.haste, camera, options_.threads);
-  else
+    error_time_s_ = options_.haste.error_time_s;
+    position_sigma_px_ = options_.haste.position_sigma_px;
+  } else {
     tracker_ = std::make_unique<KltTracker>(options_.klt, camera, T_B_C);
+    error_time_s_ = options_.klt.error_time_s;
+    position_sigma_px_ = options_.klt.position_sigma_px;
+  }
   if (options_.image_source == "reconstructed")
     reconstructor_ = std::make_unique<ImageReconstructor>(options_.reconstruction, camera.width(), camera.height());
-  error_time_s_ = options_.tracker == "eklt"    ? options_.eklt.error_time_s
-                  : options_.tracker == "haste" ? options_.haste.error_time_s
-                                                : options_.klt.error_time_s;
-  position_sigma_px_ = options_.tracker == "haste" ? options_.haste.position_sigma_px
-                       : options_.tracker == "klt" ? options_.klt.position_sigma_px
-                                                   : 0.0;
   if (options_.track_lag.estimate && options_.tracker != "klt")
     probe_ = std::make_unique<FrameLagProbe>(options_.track_lag);
 }

@@ -15,6 +15,7 @@
 #include "evio/core/error.h"
 #include "evio/core/io/config.h"
 #include "evio/core/io/staged_folder.h"
+#include "evio/estimator/pipeline/method_settings.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "data_root.h"
 #include "progress_line.h"
@@ -73,6 +74,7 @@ void addEstimateCommand(CLI::App& app) {
       }
     }
     config::applyOverride(doc, "method=" + args->method);
+    estimator::applyMethodSettings(doc, args->method);  // the method's own section of the file (method_settings.h)
     if (!args->init.empty()) config::applyOverride(doc, "init.mode=" + args->init);
     if (!args->tracks.empty()) config::applyOverride(doc, "tracks.file=" + args->tracks);
     if (args->track_noise_px >= 0.0) config::applyOverride(doc, "tracks.noise_px=" + std::to_string(args->track_noise_px));

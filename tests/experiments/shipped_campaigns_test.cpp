@@ -16,6 +16,7 @@
 
 #include "evio/core/error.h"
 #include "evio/core/io/config.h"
+#include "evio/estimator/pipeline/method_settings.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "evio/experiments/campaign.h"
 #include "evio/experiments/campaign_runner.h"
@@ -41,7 +42,8 @@ std::string optionValue(const std::vector<std::string>& command, const std::stri
 
 /// What `evio estimate [--config <config>] [--method <name>] [--init <mode>] --set …`
 /// does with the settings (estimate_command.cpp): --method wins, else the
-/// settings' `method`; --init sets init.mode; then every key is filled and checked.
+/// settings' `method`; the method's own section is merged (method_settings.h);
+/// --init sets init.mode; then every key is filled and checked.
 void checkEstimatorSettings(const std::string& config_file, const Overrides& estimate_set,
                             const std::string& command_method, const std::string& command_init) {
   config::Document doc = config_file.empty() ? config::loadString("{}", "<defaults>") : config::loadFile(config_file);
@@ -53,6 +55,7 @@ void checkEstimatorSettings(const std::string& config_file, const Overrides& est
     m = config::scalarAs<std::string>(doc, node, "method");
   }
   config::applyOverride(doc, "method=" + m);
+  estimator::applyMethodSettings(doc, m);
   if (!command_init.empty()) config::applyOverride(doc, "init.mode=" + command_init);
   estimator::PipelineOptions options = estimator::PipelineOptions::forMethod(m);
   config::fill(doc, "", options);

@@ -50,6 +50,15 @@ bool whitenSharedTrackError(const FilterState& state, const std::vector<CameraCl
   return true;
 }
 
+// The track's rows, whitened for a shared track error when the state
+// carries one, projected on the left null space of its point columns H_f.
+bool projectTrackRows(const FilterState& state, const std::vector<CameraClone>& clones, const std::vector<Mat2>& W,
+                      double sigma2_z, MatX* H_x, MatX* H_f, VecX* r) {
+  if (state.hasTrackErrors() && !whitenSharedTrackError(state, clones, W, sigma2_z, H_x, H_f, r)) return false;
+  projectOnLeftNullSpace(*H_f, H_x, r);
+  return true;
+}
+
 }  // namespace
 
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
@@ -64,7 +73,7 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
   if (rotationCompensatedDisparity(clones, z) < min_parallax) return MsckfOutcome::kNoParallax;
   TriangulationResult tri;
   if (!triangulateFeature(clones, z, n - 1, triangulation, &tri)) return MsckfOutcome::kTriangulationFailed;
-  if (!knowsDepth(tri, triangulation)) return MsckfOutcome::kNoParallax;
+  if (!knowsDepth(tri, triangulation)) return MsckfOutcome::kDepthUnknown;
 
   const Eigen::Index m = 2 * static_cast<Eigen::Index>(n);
   MatX H_x = MatX::Zero(m, state.dim());
@@ -82,12 +91,82 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
     H_f.block<2, 3>(row, 0) = W[i] * Hp;
   }
   if (m <= 3) return MsckfOutcome::kTooShort;
-  if (state.hasTrackErrors() && !whitenSharedTrackError(state, clones, W, sigma2_z, &H_x, &H_f, &r))
-    return MsckfOutcome::kProjectionFailed;
-  projectOnLeftNullSpace(H_f, &H_x, &r);
+  if (!projectTrackRows(state, clones, W, sigma2_z, &H_x, &H_f, &r)) return MsckfOutcome::kProjectionFailed;
   out->H = std::move(H_x);
   out->r = std::move(r);
   out->p_W = tri.p_W;
+  return MsckfOutcome::kOk;
+}
+
+namespace {
+
+// The anchored feature (α, β, ρ) in clone a that best explains the track's
+// observations together with the depth prior ρ ~ N(ρ0, σ_ρ0²): Gauss–Newton
+// on Σ ‖W_i (z_i − π_i(α, β, ρ))‖² / σ_z² + (ρ − ρ0)² / σ_ρ0², started at the
+// anchor's own observation and ρ0. A track without parallax says little of
+// ρ, so the prior holds it near ρ0.
+bool fitFeatureWithDepthPrior(const std::vector<CameraClone>& clones, const std::vector<Vec2>& z,
+                              const std::vector<Mat2>& W, std::size_t a, double sigma2_z, double rho0,
+                              double sigma_rho0, Vec3* abr) {
+  *abr = Vec3(z[a].x(), z[a].y(), rho0);
+  const double prior_weight = sigma2_z / (sigma_rho0 * sigma_rho0);  // in units of one whitened row
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    Mat3 JtJ = Mat3::Zero();
+    Vec3 Jtr = Vec3::Zero();
+    for (std::size_t i = 0; i < clones.size(); ++i) {
+      Vec2 zh;
+      Mat23 J;
+      if (!projectAnchoredFeature(clones[a], clones[i], *abr, &zh, nullptr, nullptr, &J)) return false;
+      const Mat23 Jw = W[i] * J;
+      JtJ += Jw.transpose() * Jw;
+      Jtr += Jw.transpose() * (W[i] * (z[i] - zh));
+    }
+    JtJ(2, 2) += prior_weight;
+    Jtr(2) += prior_weight * (rho0 - abr->z());
+    const Vec3 step = JtJ.ldlt().solve(Jtr);
+    if (!step.allFinite()) return false;
+    *abr += step;
+    if (step.norm() < 1e-10) break;
+  }
+  return abr->z() >= 0.0;
+}
+
+}  // namespace
+
+MsckfOutcome rotationResidual(const FilterState& state, const FeatureTrack& track, MsckfResidual* out,
+                              double sigma2_z, double rho0, double sigma_rho0) {
+  std::vector<CameraClone> clones;
+  std::vector<std::size_t> pos;
+  std::vector<Vec2> z;
+  std::vector<Mat2> W;
+  gatherTrack(state, track, &clones, &pos, &z, &W);
+  const std::size_t n = clones.size();
+  if (n < 2) return MsckfOutcome::kTooShort;
+  const std::size_t a = n - 1;
+  Vec3 abr;
+  if (!fitFeatureWithDepthPrior(clones, z, W, a, sigma2_z, rho0, sigma_rho0, &abr))
+    return MsckfOutcome::kProjectionFailed;
+
+  const Eigen::Index m = 2 * static_cast<Eigen::Index>(n);
+  MatX H_x = MatX::Zero(m, state.dim());
+  MatX H_f(m, 3);
+  VecX r(m);
+  const Eigen::Index anchor_col = state.cloneIndex(pos[a]);
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec2 zh;
+    Mat26 Ha, Hc;
+    Mat23 Hf;
+    if (!projectAnchoredFeature(clones[a], clones[i], abr, &zh, &Ha, &Hc, &Hf)) return MsckfOutcome::kProjectionFailed;
+    const Eigen::Index row = 2 * static_cast<Eigen::Index>(i);
+    r.segment<2>(row) = W[i] * (z[i] - zh);
+    H_x.block<2, 6>(row, state.cloneIndex(pos[i])) += W[i] * Hc;
+    H_x.block<2, 6>(row, anchor_col) += W[i] * Ha;
+    H_f.block<2, 3>(row, 0) = W[i] * Hf;
+  }
+  if (!projectTrackRows(state, clones, W, sigma2_z, &H_x, &H_f, &r)) return MsckfOutcome::kProjectionFailed;
+  out->H = std::move(H_x);
+  out->r = std::move(r);
+  out->p_W = Vec3::Zero();
   return MsckfOutcome::kOk;
 }
 

@@ -27,31 +27,48 @@ UpdateRows stackRows(const std::vector<MsckfResidual>& used, Eigen::Index dim) {
 UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* tracks) {
   const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
+  const double prior_sigma = fixedDepthPriorSigma();
+  const double prior_rho0 = 2.0 * prior_sigma;  // 1/(2 d_min): the fixed depth prior (updater.h)
   std::vector<MsckfResidual> used;
   used_.clear();
+  used_rotation_.clear();
   for (const FeatureId id : ids) {
     FeatureTrack& track = (*tracks)[id];
     MsckfResidual res;
-    const MsckfOutcome outcome = msckfResidual(state(), track, min_parallax, tri, &res, sigma2_);
+    MsckfOutcome outcome = msckfResidual(state(), track, min_parallax, tri, &res, sigma2_);
+    bool rotation = false;
+    if (outcome == MsckfOutcome::kNoParallax || outcome == MsckfOutcome::kDepthUnknown) {
+      ++stats().msckf_features_no_parallax;
+      // Rotation rows err at second order in the parallax: only below the
+      // minimum disparity (docs/algorithms.md "Rotation rows").
+      if (options().msckf_rotation_rows && outcome == MsckfOutcome::kNoParallax) {
+        outcome = rotationResidual(state(), track, &res, sigma2_, prior_rho0, prior_sigma);
+        rotation = true;
+      }
+    }
     FeatureTrack copy;
     if (options().msckf_iterations > 1) copy = track;
     track.observations.clear();
-    if (outcome == MsckfOutcome::kNoParallax) {
-      ++stats().msckf_features_no_parallax;
-      continue;
-    }
+    if (outcome == MsckfOutcome::kNoParallax || outcome == MsckfOutcome::kDepthUnknown) continue;
     if (outcome != MsckfOutcome::kOk) {
       ++stats().msckf_triangulation_failed;
       continue;
     }
     constrain(&res.H);
     if (!passesRecordedGate(res.H, res.r, sigma2_, (*chi2_)(static_cast<int>(res.r.size())))) {
-      ++stats().msckf_features_rejected;
+      ++(rotation ? stats().msckf_rotation_rejected : stats().msckf_features_rejected);
       continue;
     }
-    triangulatedPoints().add(res.p_W);
+    if (rotation) {
+      ++stats().msckf_rotation_used;
+    } else {
+      triangulatedPoints().add(res.p_W);
+    }
     used.push_back(std::move(res));
-    if (options().msckf_iterations > 1) used_.push_back(std::move(copy));
+    if (options().msckf_iterations > 1) {
+      used_.push_back(std::move(copy));
+      used_rotation_.push_back(rotation);
+    }
   }
   last_count_ = static_cast<int>(used.size());
   stats().msckf_features_used += last_count_;
@@ -61,10 +78,15 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
 UpdateRows MsckfUpdater::relinearize(const FilterState& x) const {
   const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
+  const double prior_sigma = fixedDepthPriorSigma();
+  const double prior_rho0 = 2.0 * prior_sigma;
   std::vector<MsckfResidual> rows;
-  for (const FeatureTrack& track : used_) {
+  for (std::size_t k = 0; k < used_.size(); ++k) {
+    const FeatureTrack& track = used_[k];
     MsckfResidual res;
-    if (msckfResidual(x, track, min_parallax, tri, &res, sigma2_) != MsckfOutcome::kOk) continue;
+    const MsckfOutcome outcome = used_rotation_[k] ? rotationResidual(x, track, &res, sigma2_, prior_rho0, prior_sigma)
+                                                   : msckfResidual(x, track, min_parallax, tri, &res, sigma2_);
+    if (outcome != MsckfOutcome::kOk) continue;
     constrainAt(x, &res.H);
     rows.push_back(std::move(res));
   }

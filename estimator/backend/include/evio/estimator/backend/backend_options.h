@@ -168,6 +168,12 @@ struct BackendOptions {
   // MSCKF features ----------------------------------------------------------------
   /// Also use tracks lost before spanning the window (xVIO drops them).
   bool msckf_use_lost_tracks = false;
+  /// A track with too little parallax to triangulate (xVIO drops it) still
+  /// tells how the camera turned between its clones: its rows, linearised at
+  /// the fixed depth prior with the depth projected out, constrain the
+  /// clones' relative attitude (msckf_update.h rotationResidual;
+  /// docs/algorithms.md "Rotation rows"). Off: such tracks are dropped.
+  bool msckf_rotation_rows = false;
   int msckf_min_track_length = 3;          ///< fewer observations: not used (>= 2)
   /// Rotation-compensated disparity an MSCKF track needs before it is
   /// triangulated, px. xVIO's 30 px kept MSCKF features out of every scene
@@ -324,6 +330,7 @@ struct BackendOptions {
     v("slam_track_error_time_s", slam_track_error_time_s, "track errors as states: correlation time, s");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
     v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");
+    v("msckf_rotation_rows", msckf_rotation_rows, "tracks without parallax give rows at the depth prior, depth projected out");
     v("min_parallax_px", min_parallax_px, "rotation-compensated disparity for an MSCKF triangulation, px");
     v("slam_min_parallax_px", slam_min_parallax_px, "rotation-compensated disparity for a triangulated SLAM initialisation, px");
     v("triangulate_when_better_than_prior", triangulate_when_better_than_prior,

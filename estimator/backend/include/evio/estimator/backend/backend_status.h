@@ -39,6 +39,8 @@ struct BackendStats {
   std::int64_t msckf_features_rejected = 0;  ///< χ² gate
   std::int64_t msckf_features_no_parallax = 0;
   std::int64_t msckf_triangulation_failed = 0;
+  std::int64_t msckf_rotation_used = 0;      ///< of msckf_features_used: rotation rows (msckf_rotation_rows)
+  std::int64_t msckf_rotation_rejected = 0;  ///< rotation rows rejected by the χ² gate
   std::int64_t slam_initialized_triangulated = 0;
   std::int64_t slam_initialized_prior = 0;
   std::int64_t slam_initialized_range = 0;  ///< depth prior from the range finder
@@ -67,6 +69,8 @@ struct BackendStats {
     v("msckf_features_rejected", msckf_features_rejected, "MSCKF features rejected by the chi-squared gate");
     v("msckf_features_no_parallax", msckf_features_no_parallax, "msckf features no parallax");
     v("msckf_triangulation_failed", msckf_triangulation_failed, "msckf triangulation failed");
+    v("msckf_rotation_used", msckf_rotation_used, "of the MSCKF features used, tracks without parallax used as rotation rows");
+    v("msckf_rotation_rejected", msckf_rotation_rejected, "rotation rows rejected by the chi-squared gate");
     v("slam_initialized_triangulated", slam_initialized_triangulated, "slam initialized triangulated");
     v("slam_initialized_prior", slam_initialized_prior, "slam initialized prior");
     v("slam_initialized_range", slam_initialized_range, "SLAM features initialised with a range-finder depth prior");

@@ -20,7 +20,10 @@
 
 namespace evio::estimator {
 
-enum class MsckfOutcome { kOk, kTooShort, kNoParallax, kTriangulationFailed, kProjectionFailed };
+/// kNoParallax: the rotation-compensated disparity is below the minimum;
+/// kDepthUnknown: the track has the disparity but its triangulation fixes
+/// the depth worse than the prior would (knowsDepth).
+enum class MsckfOutcome { kOk, kTooShort, kNoParallax, kDepthUnknown, kTriangulationFailed, kProjectionFailed };
 
 struct MsckfResidual {
   MatX H;               ///< (2n − 3) × dim, null-space projected
@@ -37,11 +40,26 @@ void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vecto
 
 /// The null-space projected MSCKF residual of `track`. min_parallax is the
 /// rotation-compensated disparity (normalised units) the track must exceed;
-/// a triangulation that fails knowsDepth(·, triangulation) counts as
-/// kNoParallax too. sigma2_z: σ_z², the noise of one whitened row, needed
+/// a triangulation that fails knowsDepth(·, triangulation) is kDepthUnknown. sigma2_z: σ_z², the noise of one whitened row, needed
 /// only with track-error states (the shared error's whitening; must then be
 /// positive).
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
                            const TriangulationOptions& triangulation, MsckfResidual* out, double sigma2_z = 0.0);
+
+/// The rows of a track without the parallax to triangulate (docs/algorithms.md
+/// "Rotation rows"). The point is anchored in the track's last clone a in
+/// inverse depth, each observation
+///   z_i = π(R_iᵀ (R_a b + ρ (p_a − p_i))),   b = (α, β, 1),
+/// and (α, β, ρ) fitted to the observations together with the depth prior
+/// ρ ~ N(rho0, sigma_rho0²) (Gauss–Newton; sigma2_z: σ_z² of one whitened
+/// row). The residuals are linearised there and projected on the left null
+/// space of all three columns ∂z/∂(α, β, ρ): 2n − 3 rows. The ρ column is the
+/// flow a translation gives the track, so what the depth's error does to
+/// it is removed to first order; what remains constrains mostly the clones'
+/// relative attitude, and their positions as a point at the fitted depth
+/// would. No point is triangulated (out->p_W stays zero). kTooShort below
+/// two observations.
+MsckfOutcome rotationResidual(const FilterState& state, const FeatureTrack& track, MsckfResidual* out,
+                              double sigma2_z, double rho0, double sigma_rho0);
 
 }  // namespace evio::estimator

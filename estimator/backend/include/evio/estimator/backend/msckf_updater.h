@@ -21,8 +21,9 @@ class MsckfUpdater : public Updater {
   const char* name() const override { return "msckf"; }
 
   /// The stacked rows (H: rows × state dimension) of the tracks `ids` that
-  /// triangulate with enough parallax and pass the gate, in the order of
-  /// `ids`; outcomes are counted in the stats. Every track in `ids` is
+  /// triangulate with enough parallax (or, with msckf_rotation_rows, give
+  /// rotation rows without it) and pass the gate, in the order of `ids`;
+  /// outcomes are counted in the stats. Every track in `ids` is
   /// emptied (used or unusable: never twice).
   UpdateRows residuals(const std::vector<FeatureId>& ids, TrackMap* tracks);
   /// Features used by the last residuals() call.
@@ -39,6 +40,7 @@ class MsckfUpdater : public Updater {
   const Chi2Table* chi2_;
   int last_count_ = 0;
   std::vector<FeatureTrack> used_;  // copies of the tracks the last residuals() used
+  std::vector<bool> used_rotation_;  // per used_ track: rotation rows (msckf_rotation_rows), else triangulated
 };
 
 }  // namespace evio::estimator

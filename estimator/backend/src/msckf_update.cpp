@@ -26,6 +26,21 @@ void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vecto
 
 namespace {
 
+// A track's observations in the clones still in the window, with their
+// whitening matrices (gatherTrack).
+struct TrackInWindow {
+  std::vector<CameraClone> clones;
+  std::vector<std::size_t> positions;
+  std::vector<Vec2> z;
+  std::vector<Mat2> whiten;
+};
+
+TrackInWindow trackInWindow(const FilterState& state, const FeatureTrack& track) {
+  TrackInWindow t;
+  gatherTrack(state, track, &t.clones, &t.positions, &t.z, &t.whiten);
+  return t;
+}
+
 // Rows already whitened one by one (W_i) share the track's error e(t_i):
 // C/σ_z² = I + [ρ_ij W_i Σ_e W_jᵀ / σ_z²], ρ_ij = exp(−|t_i − t_j|/τ); the
 // rows are replaced by L⁻¹ rows, C/σ_z² = L Lᵀ, so their noise is σ_z² I again.
@@ -63,11 +78,8 @@ bool projectTrackRows(const FilterState& state, const std::vector<CameraClone>& 
 
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
                            const TriangulationOptions& triangulation, MsckfResidual* out, double sigma2_z) {
-  std::vector<CameraClone> clones;
-  std::vector<std::size_t> pos;
-  std::vector<Vec2> z;
-  std::vector<Mat2> W;
-  gatherTrack(state, track, &clones, &pos, &z, &W);
+  const TrackInWindow in_window = trackInWindow(state, track);
+  const auto& [clones, pos, z, W] = in_window;
   const std::size_t n = clones.size();
   if (n < 2) return MsckfOutcome::kTooShort;
   if (rotationCompensatedDisparity(clones, z) < min_parallax) return MsckfOutcome::kNoParallax;
@@ -135,11 +147,8 @@ bool fitFeatureWithDepthPrior(const std::vector<CameraClone>& clones, const std:
 
 MsckfOutcome rotationResidual(const FilterState& state, const FeatureTrack& track, MsckfResidual* out,
                               double sigma2_z, double rho0, double sigma_rho0) {
-  std::vector<CameraClone> clones;
-  std::vector<std::size_t> pos;
-  std::vector<Vec2> z;
-  std::vector<Mat2> W;
-  gatherTrack(state, track, &clones, &pos, &z, &W);
+  const TrackInWindow in_window = trackInWindow(state, track);
+  const auto& [clones, pos, z, W] = in_window;
   const std::size_t n = clones.size();
   if (n < 2) return MsckfOutcome::kTooShort;
   const std::size_t a = n - 1;

@@ -20,6 +20,7 @@
 #include "evio/core/io/config.h"
 #include "evio/core/io/tum.h"
 #include "evio/estimator/pipeline/groundtruth_init.h"
+#include "evio/estimator/pipeline/method_settings.h"
 #include "evio/estimator/pipeline/pipeline.h"
 #include "evio/simulator/sequence_simulator.h"
 #include "support/timing_columns.h"
@@ -29,10 +30,13 @@ namespace evio::estimator {
 namespace {
 
 /// A method with estimator/config/sim.yaml started from the ground truth
-/// (`evio estimate --config estimator/config/sim.yaml --init groundtruth`).
+/// (`evio estimate --config estimator/config/sim.yaml --init groundtruth`,
+/// the method's own section of the file included).
 PipelineOptions fromGroundTruth(std::string_view method) {
   PipelineOptions o = PipelineOptions::forMethod(method);
-  config::fill(config::loadFile(std::string(EVIO_SOURCE_DIR) + "/estimator/config/sim.yaml"), "", o);
+  config::Document doc = config::loadFile(std::string(EVIO_SOURCE_DIR) + "/estimator/config/sim.yaml");
+  applyMethodSettings(doc, method);
+  config::fill(doc, "", o);
   o.init.mode = "groundtruth";
   return o;
 }

@@ -31,4 +31,6 @@ std::string methodNames() {
   return out;
 }
 
+std::vector<MethodInfo> allMethods() { return {kMethods.begin(), kMethods.end()}; }
+
 }  // namespace evio::estimator

@@ -38,8 +38,7 @@ void mergeSection(const config::Document& doc, YAML::Node target, const YAML::No
 
 void applyMethodSettings(config::Document& doc, std::string_view method) {
   std::vector<std::string> names;
-  for (const Method m : {Method::kEkltVio, Method::kKltVio, Method::kHasteVio, Method::kTracks})
-    names.emplace_back(methodInfo(m).name);
+  for (const MethodInfo& m : allMethods()) names.emplace_back(m.name);
   for (const std::string& name : names) {
     const YAML::Node section = doc.root[name];
     if (!section.IsDefined() || section.IsNull()) continue;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace evio::estimator {
 
@@ -32,5 +33,7 @@ const MethodInfo& methodInfo(Method method);
 std::optional<Method> parseMethod(std::string_view name);
 /// "eklt-vio, klt-vio, haste-vio, tracks" (for messages and the CLI).
 std::string methodNames();
+/// Every method's entry, in that order.
+std::vector<MethodInfo> allMethods();
 
 }  // namespace evio::estimator

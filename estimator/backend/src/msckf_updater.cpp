@@ -27,8 +27,6 @@ UpdateRows stackRows(const std::vector<MsckfResidual>& used, Eigen::Index dim) {
 UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* tracks) {
   const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
-  const double prior_sigma = fixedDepthPriorSigma();
-  const double prior_rho0 = 2.0 * prior_sigma;  // 1/(2 d_min): the fixed depth prior (updater.h)
   std::vector<MsckfResidual> used;
   used_.clear();
   used_rotation_.clear();
@@ -42,7 +40,7 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
       // Rotation rows err at second order in the parallax: only below the
       // minimum disparity (docs/algorithms.md "Rotation rows").
       if (options().msckf_rotation_rows && outcome == MsckfOutcome::kNoParallax) {
-        outcome = rotationResidual(state(), track, &res, sigma2_, prior_rho0, prior_sigma);
+        outcome = rotationResidual(state(), track, &res, sigma2_, fixedDepthPriorRho(), fixedDepthPriorSigma());
         rotation = true;
       }
     }
@@ -78,13 +76,12 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
 UpdateRows MsckfUpdater::relinearize(const FilterState& x) const {
   const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
-  const double prior_sigma = fixedDepthPriorSigma();
-  const double prior_rho0 = 2.0 * prior_sigma;
   std::vector<MsckfResidual> rows;
   for (std::size_t k = 0; k < used_.size(); ++k) {
     const FeatureTrack& track = used_[k];
     MsckfResidual res;
-    const MsckfOutcome outcome = used_rotation_[k] ? rotationResidual(x, track, &res, sigma2_, prior_rho0, prior_sigma)
+    const MsckfOutcome outcome = used_rotation_[k] ? rotationResidual(x, track, &res, sigma2_, fixedDepthPriorRho(),
+                                                                    fixedDepthPriorSigma())
                                                    : msckfResidual(x, track, min_parallax, tri, &res, sigma2_);
     if (outcome != MsckfOutcome::kOk) continue;
     constrainAt(x, &res.H);

@@ -40,9 +40,9 @@ void gatherTrack(const FilterState& state, const FeatureTrack& track, std::vecto
 
 /// The null-space projected MSCKF residual of `track`. min_parallax is the
 /// rotation-compensated disparity (normalised units) the track must exceed;
-/// a triangulation that fails knowsDepth(·, triangulation) is kDepthUnknown. sigma2_z: σ_z², the noise of one whitened row, needed
-/// only with track-error states (the shared error's whitening; must then be
-/// positive).
+/// a triangulation that fails knowsDepth(·, triangulation) is kDepthUnknown.
+/// sigma2_z: σ_z², the noise of one whitened row, needed only with
+/// track-error states (the shared error's whitening; must then be positive).
 MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, double min_parallax,
                            const TriangulationOptions& triangulation, MsckfResidual* out, double sigma2_z = 0.0);
 

@@ -79,6 +79,8 @@ class Updater {
   TriangulationOptions triangulationOptions(double sigma_z, double prior_sigma_rho) const;
   /// σ_ρ0 = 1/(4 d_min) of the fixed depth prior, 1/m.
   double fixedDepthPriorSigma() const { return 1.0 / (4.0 * options().slam_min_depth_m); }
+  /// ρ0 = 1/(2 d_min), the fixed depth prior's inverse depth, 1/m.
+  double fixedDepthPriorRho() const { return 1.0 / (2.0 * options().slam_min_depth_m); }
   /// A parallax in px in normalised units: divided by the mean focal length of `camera`.
   double minParallaxNormalized(const Camera& camera, double parallax_px) const;
 

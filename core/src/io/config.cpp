@@ -80,10 +80,14 @@ void applyOverride(Document& doc, const std::string& assignment) {
   doc.overridden.insert(path);
 }
 
-std::string where(const Document& doc, const YAML::Node& node, const std::string& path) {
+const std::string* overriddenBy(const Document& doc, const std::string& path) {
   for (const auto& o : doc.overridden)
-    if (path == o || path.rfind(o + ".", 0) == 0 || path.rfind(o + "[", 0) == 0)
-      return "--set " + o;
+    if (path == o || path.rfind(o + ".", 0) == 0 || path.rfind(o + "[", 0) == 0) return &o;
+  return nullptr;
+}
+
+std::string where(const Document& doc, const YAML::Node& node, const std::string& path) {
+  if (const std::string* o = overriddenBy(doc, path)) return "--set " + *o;
   const auto mark = node.Mark();
   if (mark.line >= 0) return doc.file + ":" + std::to_string(mark.line + 1);
   return doc.file;

@@ -29,7 +29,6 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
   std::vector<MsckfResidual> used;
   used_.clear();
-  used_rotation_.clear();
   for (const FeatureId id : ids) {
     FeatureTrack& track = (*tracks)[id];
     MsckfResidual res;
@@ -63,10 +62,7 @@ UpdateRows MsckfUpdater::residuals(const std::vector<FeatureId>& ids, TrackMap* 
       triangulatedPoints().add(res.p_W);
     }
     used.push_back(std::move(res));
-    if (options().msckf_iterations > 1) {
-      used_.push_back(std::move(copy));
-      used_rotation_.push_back(rotation);
-    }
+    if (options().msckf_iterations > 1) used_.push_back({std::move(copy), rotation});
   }
   last_count_ = static_cast<int>(used.size());
   stats().msckf_features_used += last_count_;
@@ -77,12 +73,11 @@ UpdateRows MsckfUpdater::relinearize(const FilterState& x) const {
   const TriangulationOptions tri = triangulationOptions(std::sqrt(sigma2_), fixedDepthPriorSigma());
   const double min_parallax = minParallaxNormalized(camera_, options().min_parallax_px);
   std::vector<MsckfResidual> rows;
-  for (std::size_t k = 0; k < used_.size(); ++k) {
-    const FeatureTrack& track = used_[k];
+  for (const UsedTrack& used : used_) {
     MsckfResidual res;
-    const MsckfOutcome outcome = used_rotation_[k] ? rotationResidual(x, track, &res, sigma2_, fixedDepthPriorRho(),
-                                                                    fixedDepthPriorSigma())
-                                                   : msckfResidual(x, track, min_parallax, tri, &res, sigma2_);
+    const MsckfOutcome outcome =
+        used.rotation ? rotationResidual(x, used.track, &res, sigma2_, fixedDepthPriorRho(), fixedDepthPriorSigma())
+                      : msckfResidual(x, used.track, min_parallax, tri, &res, sigma2_);
     if (outcome != MsckfOutcome::kOk) continue;
     constrainAt(x, &res.H);
     rows.push_back(std::move(res));

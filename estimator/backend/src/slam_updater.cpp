@@ -272,7 +272,7 @@ SlamUpdater::DepthPrior SlamUpdater::depthPrior(std::size_t c, const Vec2& z) co
   if (const auto rho = rangeDepthPrior(state().clones[c], z))
     return {*rho, options().range_prior_relative_sigma * *rho, DepthPrior::Source::kRange};
   // The fixed prior: ρ0 = 1/(2 d_min), σ_ρ0 = 1/(4 d_min), i.e. σ_ρ0 = ρ0 / 2.
-  const DepthPrior fixed{1.0 / (2.0 * options().slam_min_depth_m), fixedDepthPriorSigma(), DepthPrior::Source::kFixed};
+  const DepthPrior fixed{fixedDepthPriorRho(), fixedDepthPriorSigma(), DepthPrior::Source::kFixed};
   if (!options().depth_prior_from_map) return fixed;
   // The same shape centred on the median inverse depth of what the filter triangulated.
   std::vector<Vec3> points = convergedSlamPoints(state(), options().map_prior_max_relative_sigma);

@@ -9,13 +9,6 @@ namespace evio::estimator {
 
 namespace {
 
-// True when `path` or a map above it was set on the command line.
-bool setOnCommandLine(const config::Document& doc, const std::string& path) {
-  for (const std::string& o : doc.overridden)
-    if (path == o || path.rfind(o + ".", 0) == 0) return true;
-  return false;
-}
-
 // Copies every key of `section` into `target` at `prefix`, recursing into
 // maps present in both; nodes are shared, so messages about them still
 // name the section's file and line.
@@ -24,7 +17,7 @@ void mergeSection(const config::Document& doc, YAML::Node target, const YAML::No
   for (const auto& kv : section) {
     const std::string key = kv.first.as<std::string>();
     const std::string path = prefix.empty() ? key : prefix + "." + key;
-    if (setOnCommandLine(doc, path)) continue;
+    if (config::overriddenBy(doc, path) != nullptr) continue;  // --set wins
     YAML::Node existing = target[key];
     if (kv.second.IsMap() && existing.IsDefined() && existing.IsMap()) {
       mergeSection(doc, existing, kv.second, path);
@@ -37,16 +30,15 @@ void mergeSection(const config::Document& doc, YAML::Node target, const YAML::No
 }  // namespace
 
 void applyMethodSettings(config::Document& doc, std::string_view method) {
-  std::vector<std::string> names;
-  for (const MethodInfo& m : allMethods()) names.emplace_back(m.name);
-  for (const std::string& name : names) {
-    const YAML::Node section = doc.root[name];
-    if (!section.IsDefined() || section.IsNull()) continue;
-    if (!section.IsMap()) config::throwAt(doc, section, name, "expected a map of settings for " + name + " only");
+  const std::vector<MethodInfo> methods = allMethods();
+  for (const MethodInfo& m : methods) {
+    const YAML::Node section = doc.root[m.name];
+    if (section.IsDefined() && !section.IsNull() && !section.IsMap())
+      config::throwAt(doc, section, m.name, "expected a map of settings for " + std::string(m.name) + " only");
   }
   const YAML::Node own = doc.root[std::string(method)];
   if (own.IsDefined() && own.IsMap()) mergeSection(doc, doc.root, own, "");
-  for (const std::string& name : names) doc.root.remove(name);
+  for (const MethodInfo& m : methods) doc.root.remove(m.name);
 }
 
 }  // namespace evio::estimator

@@ -36,6 +36,10 @@ Document loadString(const std::string& text, const std::string& name = "<string>
 /// intermediate maps. Throws Error on a malformed override.
 void applyOverride(Document& doc, const std::string& assignment);
 
+/// The set path that dotted `path` was set by on the command line (itself
+/// or a map or list above it), or nullptr when the file gave it.
+const std::string* overriddenBy(const Document& doc, const std::string& path);
+
 /// Where a node is, for messages: "file:line" or "--set a.b=…".
 std::string where(const Document& doc, const YAML::Node& node, const std::string& path);
 

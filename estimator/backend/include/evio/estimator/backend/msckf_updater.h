@@ -39,8 +39,11 @@ class MsckfUpdater : public Updater {
   double sigma2_;
   const Chi2Table* chi2_;
   int last_count_ = 0;
-  std::vector<FeatureTrack> used_;  // copies of the tracks the last residuals() used
-  std::vector<bool> used_rotation_;  // per used_ track: rotation rows (msckf_rotation_rows), else triangulated
+  struct UsedTrack {
+    FeatureTrack track;
+    bool rotation = false;  // rotation rows (msckf_rotation_rows), else triangulated
+  };
+  std::vector<UsedTrack> used_;  // copies of the tracks the last residuals() used
 };
 
 }  // namespace evio::estimator

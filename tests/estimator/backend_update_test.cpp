@@ -309,6 +309,38 @@ TEST(BackendEkfUpdate, JosephFormEqualsTheTextbookProduct) {
   EXPECT_LT((a.P - a.P.transpose()).norm(), 1e-18);
 }
 
+// covariance_factor κ: the gain keeps σ², the covariance is that of the
+// estimate under noise κ σ², (I − KH) P (I − KH)ᵀ + κ σ² K Kᵀ, in both forms;
+// the mean moves exactly as with κ = 1. The iterated update passes κ on.
+TEST(BackendEkfUpdate, CovarianceFactorKeepsTheGainAndWidensTheNoiseTerm) {
+  const FilterState s0 = stateWith(arcOfClones(4, 10), 10);
+  const int m = 5, n = s0.dim();
+  const auto [H, r] = randomRows(m, n, 12);
+  const double sigma2 = 1e-4, kappa = 3.0;
+  const MatX S = H * s0.P * H.transpose() + sigma2 * MatX::Identity(m, m);
+  const MatX K = s0.P * H.transpose() * S.inverse();
+  const MatX IKH = MatX::Identity(n, n) - K * H;
+  const MatX expected = IKH * s0.P * IKH.transpose() + kappa * sigma2 * K * K.transpose();
+  FilterState optimal = s0;
+  ASSERT_TRUE(ekfUpdate(optimal, H, r, sigma2, false));
+  for (const bool joseph : {true, false}) {
+    FilterState a = s0;
+    ASSERT_TRUE(ekfUpdate(a, H, r, sigma2, joseph, kappa));
+    EXPECT_LT((a.P - expected).norm(), 1e-10 * s0.P.norm()) << "joseph " << joseph;
+    EXPECT_LT(a.minus(optimal).norm(), 1e-12) << "joseph " << joseph;
+    // Wider than the optimal update's covariance by exactly (κ − 1) σ² K Kᵀ.
+    EXPECT_LT((a.P - optimal.P - (kappa - 1.0) * sigma2 * K * K.transpose()).norm(), 1e-10 * s0.P.norm());
+  }
+  FilterState iterated = s0;
+  const auto no_relinearized_rows = [](const FilterState&, MatX* Hl, VecX* rl) {
+    Hl->resize(0, 0);
+    rl->resize(0);
+  };
+  ASSERT_TRUE(iteratedEkfUpdate(iterated, no_relinearized_rows, H, r, sigma2, 1, false, kappa));
+  // The iterated update compresses (H, r) by QR first: the same information.
+  EXPECT_LT((iterated.P - expected).norm(), 1e-8 * s0.P.norm());
+}
+
 TEST(BackendSlamInit, DepthPriorAndTriangulatedInitialisation) {
   const auto clones = arcOfClones(8, 11, 1.0);
   FilterState s = stateWith(clones, 11);

@@ -65,6 +65,7 @@ void BackendOptions::validate() const {
   requirePositive("triangulation_min_depth_m", triangulation_min_depth_m);
   requireField(iekf_iterations >= 1 && iekf_iterations <= 100, "iekf_iterations", "must be in [1, 100]");
   requireField(msckf_iterations >= 1 && msckf_iterations <= 100, "msckf_iterations", "must be in [1, 100]");
+  requireInRange("visual_covariance_factor", visual_covariance_factor, 1.0, 100.0);
   requireField(msckf_iterations == 1 || iekf_iterations == 1, "msckf_iterations",
                "iterating the MSCKF rows needs iekf_iterations = 1 (the SLAM rows then stay linearised once)");
   requireInRange("max_delay_s", max_delay_s, 0.0, 60.0);  // measurements wait this long in memory

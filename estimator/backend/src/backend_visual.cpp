@@ -89,10 +89,10 @@ bool Backend::stackedUpdate(const std::vector<FeatureObservation>& slam_observat
       *r = std::move(rows.r);
     };
     return iteratedEkfUpdate(state_, msckf_relinearized, slam_fixed.H, slam_fixed.r, sigma_z_ * sigma_z_,
-                             options_.msckf_iterations, options_.joseph_form);
+                             options_.msckf_iterations, options_.joseph_form, options_.visual_covariance_factor);
   }
   return iteratedEkfUpdate(state_, slam_rows, msckf_rows.H, msckf_rows.r, sigma_z_ * sigma_z_,
-                           options_.iekf_iterations, options_.joseph_form);
+                           options_.iekf_iterations, options_.joseph_form, options_.visual_covariance_factor);
 }
 
 std::optional<std::size_t> Backend::cloneToMarginalize() const {

@@ -41,7 +41,8 @@ double mahalanobisSquared(const MatX& H, const VecX& r, const MatX& P, double si
   return r.dot(llt.solve(r));
 }
 
-bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph) {
+bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph,
+               double covariance_factor) {
   const MatX& P = state.P;
   const MatX PHt = P * H.transpose();
   MatX S = H * PHt;
@@ -61,10 +62,13 @@ bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, 
     const MatX AHt = A * H.transpose();
     MatX Pn = std::move(A);
     Pn.noalias() -= AHt * K.transpose();
-    Pn.noalias() += sigma2 * K * K.transpose();
+    Pn.noalias() += covariance_factor * sigma2 * K * K.transpose();
     state.P.swap(Pn);
   } else {
+    // With the optimal gain the Joseph form is P − K S Kᵀ; its noise term
+    // σ² K Kᵀ becomes κ σ² K Kᵀ, so κ adds (κ − 1) σ² K Kᵀ.
     state.P.noalias() -= K * S * K.transpose();
+    if (covariance_factor != 1.0) state.P.noalias() += (covariance_factor - 1.0) * sigma2 * K * K.transpose();
   }
   state.symmetrize();
   state.correct(dx);

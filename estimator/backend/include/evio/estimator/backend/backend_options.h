@@ -206,6 +206,13 @@ struct BackendOptions {
   /// and changed no campaign metric in its third digit over 110 EKLT-VIO
   /// and 110 KLT-VIO jobs (README "Real time").
   bool joseph_form = false;
+  /// κ ≥ 1 for the visual update (SLAM and MSCKF rows): the gain keeps the
+  /// rows' stated noise σ², the covariance takes κ σ²,
+  /// P ← (I − K H) P (I − K H)ᵀ + κ σ² K Kᵀ (ekf_update.h). That is the
+  /// covariance of the estimate when the rows' real noise is κ times what the
+  /// gain assumes, as when a tracker's errors repeat over the rows the filter
+  /// takes as independent. 1: the optimal update.
+  double visual_covariance_factor = 1.0;
   /// Observability constraint (our addition, not in xVIO): the IMU transition
   /// is evaluated at the state before the updates (first-estimate Jacobians,
   /// Huang et al. 2010) and every measurement Jacobian is projected onto the
@@ -340,6 +347,8 @@ struct BackendOptions {
     v("triangulation_tolerance", triangulation_tolerance, "relative Gauss-Newton step tolerance");
     v("triangulation_min_depth_m", triangulation_min_depth_m, "nearest triangulated depth, m");
     v("joseph_form", joseph_form, "Joseph-form covariance update");
+    v("visual_covariance_factor", visual_covariance_factor,
+      "visual update: the covariance takes the rows' noise as this factor times the gain's (1: optimal)");
     v("observability_constraint", observability_constraint, "keep global yaw unobservable (FEJ transition, OC updates)");
     v("iekf_iterations", iekf_iterations, "iterations of the visual update (1: EKF)");
     v("msckf_iterations", msckf_iterations, "iterations of the MSCKF rows, re-triangulated at each (1: EKF)");

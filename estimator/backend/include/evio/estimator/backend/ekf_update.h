@@ -28,8 +28,13 @@ double mahalanobisSquared(const MatX& H, const VecX& r, const MatX& P, double si
 /// EKF update with R = σ² I:  S = H P Hᵀ + R,  K = P Hᵀ S⁻¹,  δx = K r,
 /// P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ  (Joseph form, when joseph) or
 /// P ← P − K S Kᵀ, then symmetrised; the mean is corrected by δx.
+/// covariance_factor κ ≥ 1: the gain keeps R = σ² I but the covariance takes
+/// the rows' noise as κ σ² I, P ← (I − K H) P (I − K H)ᵀ + κ σ² K Kᵀ: the
+/// covariance of this update's estimate when the real noise is κ σ²
+/// (κ = 1: the optimal update).
 /// Returns false (state unchanged) when S is not positive definite.
-bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph);
+bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, bool joseph,
+               double covariance_factor = 1.0);
 
 /// Iterated EKF update (Bell & Cathey 1993; xVIO's iekf_iter) for a stacked
 /// measurement whose first part is re-linearised at every iterate and whose
@@ -37,14 +42,14 @@ bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, 
 ///   x_{i+1} = x_0 ⊞ K_i (r_i + H_i (x_i ⊟ x_0)),   K_i = P H_iᵀ (H_i P H_iᵀ + σ² I)⁻¹,
 /// with (H_i, r_i) = relinearize(x_i) stacked over (H_fixed, r_fixed) and QR
 /// compressed; P is updated once with the last K_i, H_i (Joseph form when
-/// joseph). iterations = 1 is the EKF update. Stops early when the step
+/// joseph; its noise taken as covariance_factor σ², see ekfUpdate). iterations = 1 is the EKF update. Stops early when the step
 /// changes by less than 1e-9 in norm. Returns false (state unchanged) when an
 /// innovation covariance is not positive definite.
 /// relinearize(const FilterState& x, MatX* H, VecX* r) must always give the
 /// same rows (same measurements) in the same order.
 template <class Relinearize>
 bool iteratedEkfUpdate(FilterState& state, Relinearize&& relinearize, const MatX& H_fixed, const VecX& r_fixed,
-                       double sigma2, int iterations, bool joseph) {
+                       double sigma2, int iterations, bool joseph, double covariance_factor = 1.0) {
   const FilterState prior = state;
   FilterState x = state;
   VecX dx_prev;
@@ -68,7 +73,7 @@ bool iteratedEkfUpdate(FilterState& state, Relinearize&& relinearize, const MatX
     if (H.rows() == 0) return true;
     compressMeasurement(&H, &r);
     FilterState trial = prior;
-    if (!ekfUpdate(trial, H, r, sigma2, joseph)) return false;
+    if (!ekfUpdate(trial, H, r, sigma2, joseph, covariance_factor)) return false;
     const VecX dx = trial.minus(prior);
     x = std::move(trial);
     if (it > 0 && (dx - dx_prev).norm() < 1e-9) break;

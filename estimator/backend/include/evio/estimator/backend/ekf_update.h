@@ -42,8 +42,9 @@ bool ekfUpdate(FilterState& state, const MatX& H, const VecX& r, double sigma2, 
 ///   x_{i+1} = x_0 ⊞ K_i (r_i + H_i (x_i ⊟ x_0)),   K_i = P H_iᵀ (H_i P H_iᵀ + σ² I)⁻¹,
 /// with (H_i, r_i) = relinearize(x_i) stacked over (H_fixed, r_fixed) and QR
 /// compressed; P is updated once with the last K_i, H_i (Joseph form when
-/// joseph; its noise taken as covariance_factor σ², see ekfUpdate). iterations = 1 is the EKF update. Stops early when the step
-/// changes by less than 1e-9 in norm. Returns false (state unchanged) when an
+/// joseph; its noise taken as covariance_factor σ², see ekfUpdate).
+/// iterations = 1 is the EKF update. Stops early when the step changes by
+/// less than 1e-9 in norm. Returns false (state unchanged) when an
 /// innovation covariance is not positive definite.
 /// relinearize(const FilterState& x, MatX* H, VecX* r) must always give the
 /// same rows (same measurements) in the same order.

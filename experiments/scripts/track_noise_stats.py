@@ -12,13 +12,13 @@ a neighbour on both sides); points with |e| above --max-error px (gross
 losses).
 
 The error is e = tracked − true, px. The filter compensates the tracker's
-lag along the motion (a + τ|v|, README "Tracker lag"), so with --lag-model
-the lag is fitted as experiments/scripts/track_lag.py fits it (lag = −e·v̂
-against the true image speed |v|, least squares over the points faster than
---min-speed px/s) and a + τ|v| is added back along v̂ of every point before
-any figure (v: the central difference of the true positions). Printed, over
-all points and per quality band (points below the first band edge count
-only in the first line):
+lag along the motion (a + τ|v|, docs/consistency.md "Tracker lag"), so with
+--lag-model the lag is fitted as experiments/scripts/track_lag.py fits it
+(lag = −e·v̂ against the true image speed |v|, least squares over the points
+faster than --min-speed px/s) and a + τ|v| is added back along v̂ of every
+point before any figure (v: the central difference of the true positions).
+Printed, over all points and per quality band (points below the first band
+edge count only in the first line):
 
   * points; share with |e| beyond 2 px;
   * the error's mean square per axis, (ex² + ey²)/2, px²;

@@ -63,7 +63,7 @@ class PipelineSimulated : public ::testing::Test {
          // the event density it was built for (an update per 3200 events, more
          // than one per frame). The calibrated pixel gives a third of the events
          // in these slow first seconds; what EKLT-VIO does with them is for the
-         // campaigns (README "Consistency").
+         // campaigns (docs/consistency.md "Consistency").
          "rig.event_camera.preset=simulator/presets/davis240c_legacy.yaml"},
         EVIO_SOURCE_DIR);
     simulator::simulateSequence(scenario, sequence());

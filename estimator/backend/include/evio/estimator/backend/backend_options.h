@@ -70,7 +70,7 @@ struct BackendOptions {
   /// front of the clone; before that, the fixed prior
   /// (docs/algorithms.md#depth-prior-from-the-map). The fixed prior fits one
   /// scene depth: a 2.5 m scene with a 1 m prior drove the ANEES into the
-  /// thousands (README "Keyframe window and triangulation").
+  /// thousands (docs/consistency.md "Keyframe window and triangulation").
   bool depth_prior_from_map = true;
   int map_prior_memory = 30;
   double map_prior_max_relative_sigma = 0.25;
@@ -88,16 +88,18 @@ struct BackendOptions {
   /// long has passed since its last one did (or since it was initialised),
   /// s (0: every measurement set, the default). An event tracker gives a
   /// feature a position at every set (up to about 300 Hz), and its errors 10 ms
-  /// apart are one error (correlation 0.8–0.9, README "Consistency from a
-  /// drawn initial error"); the skipped observations keep the feature alive
-  /// but add no rows (docs/algorithms.md#correlated-measurements).
+  /// apart are one error (correlation 0.8–0.9, docs/consistency.md
+  /// "Consistency from a drawn initial error"); the skipped observations keep
+  /// the feature alive but add no rows
+  /// (docs/algorithms.md#correlated-measurements).
   double slam_update_interval_s = 0.0;
   /// Or when the feature has moved at least this far in the image since its
   /// last update, normalised image units (0: off): whether motion, which
   /// brings new edges under the tracker's patch, decorrelates its error
-  /// better than time (measured: it does not, README "A parameter set for the
-  /// Mars rigs"). With both set, either lets an observation in; with only
-  /// this, a feature that does not move is not updated again.
+  /// better than time (measured: it does not, docs/consistency.md "A
+  /// parameter set for the Mars rigs"). With both set, either lets an
+  /// observation in; with only this, a feature that does not move is not
+  /// updated again.
   double slam_update_min_displacement_normalized = 0.0;
   bool slam_triangulated_init = true;      ///< initialise from triangulation when the track fixes the depth
   /// A feature that takes a depth prior (fixed, map or range) takes it
@@ -158,8 +160,8 @@ struct BackendOptions {
   /// and each fixed-prior feature takes ρ = ρ_s + δ with var δ = (1 − c) σ_ρ0²
   /// and δ independent: the first has the fixed prior's marginal exactly,
   /// later ones start from what the filter has learnt of ρ_s. 0: off
-  /// (independent fixed priors), the default: mixed results (README "Depth
-  /// priors that are wrong together").
+  /// (independent fixed priors), the default: mixed results
+  /// (docs/consistency.md "Depth priors that are wrong together").
   double slam_scene_depth_share = 0.0;
   /// ρ_s random-walks (the scene changes as the camera moves): its variance
   /// grows by c σ_ρ0² over this time, s.

@@ -66,7 +66,8 @@ Vec2 ekltFeaturePosition(const Vec4& p, const Vec2& accumulation_centre, const V
 /// (cost_ref ≤ 0: σ_min). Measured on EKLT's points against their truth (the
 /// lag removed; poster_6dof and mars_yard_circle, seed 101), the error's
 /// variance per axis grows as the square of the cost: 6.3 and 4.9 px² · cost²
-/// with no intercept (README "A covariance floor that follows the fit").
+/// with no intercept (docs/consistency.md "A covariance floor that follows
+/// the fit").
 double ekltSigmaFloor(double cost, double sigma_min_px, double sigma_max_px, double cost_ref);
 
 /// The covariance of the feature position ekltFeaturePosition(p, c_acc, x0)

@@ -31,7 +31,8 @@ struct EkltOptions {
   /// kDavis240cContrastThreshold. A C below the sensor's makes batches span
   /// more motion than d: on the calibrated DAVIS240C (C 0.5/0.38) the former
   /// fixed 0.25 gave 1.8× longer batches, and EKLT tracks drifted off at
-  /// every reversal of the hand-held motion (README "EKLT on real-like events").
+  /// every reversal of the hand-held motion (docs/consistency.md "EKLT on
+  /// real-like events").
   double batch_contrast_threshold = 0.0;
   int batch_min_events = 5;            ///< lower clamp of the batch size
   int batch_max_events = 500;          ///< upper clamp of the batch size
@@ -86,22 +87,24 @@ struct EkltOptions {
   /// curvature of the cost at the solution (else none: the backend's σ_img).
   /// On by default: with repeated points dropped, the lowest median error
   /// on poster, shapes and boxes on the calibrated sensors (campaign
-  /// eklt_variants, README "EKLT on real-like events").
+  /// eklt_variants, docs/consistency.md "EKLT on real-like events").
   bool position_covariance = true;
   /// Floor of the position σ along any direction, px. The curvature sees
   /// only the noise of one batch (0.05–0.5 px); a track's error is mostly
   /// what persists from batch to batch (template drift, the bias and latency
   /// of the event model), which the filter would otherwise count again at
   /// every update. Chosen by the pose ANEES on poster_6dof seeds 1–5
-  /// (README "Consistency"): 0.2 px gives ANEES in the thousands, 1 px 6.9,
-  /// 2 px 5.1 (with repeats dropped 4.4; bounds [3.36, 9.40]).
+  /// (docs/consistency.md "Consistency"): 0.2 px gives ANEES in the
+  /// thousands, 1 px 6.9, 2 px 5.1 (with repeats dropped 4.4; bounds
+  /// [3.36, 9.40]).
   double position_sigma_min_px = 2.0;
   /// Raise the floor in proportion for fits worse than this cost, up to the
   /// cap (eklt_cost.h ekltSigmaFloor: min(σ_min · max(1, cost / ref), σ_max));
   /// 0: the same floor for every point. The error's variance grows as the
   /// cost squared; a reference at the median cost of the rig's points keeps
-  /// the typical point at σ_min (README "A covariance floor that follows the
-  /// fit": 0.24 indoors, 0.33 on the Mars rigs, from seed 101).
+  /// the typical point at σ_min (docs/consistency.md "A covariance floor
+  /// that follows the fit": 0.24 indoors, 0.33 on the Mars rigs, from seed
+  /// 101).
   double position_sigma_cost_ref = 0.0;
   /// Cap of the position σ, px: the directions the patch does not constrain
   /// (along a straight edge) get this σ (the former fixed σ_img, 5 px).

@@ -46,9 +46,9 @@ struct SynchronizerOptions {
   /// Mark a feature not informative (measurements.h) when its tracker gave no
   /// new point since the previous update: the extrapolated repeat of an
   /// old point carries no new information. On by default: lower error for
-  /// EKLT-VIO and HASTE-VIO on the calibrated sensors (README "EKLT on
-  /// real-like events", campaign eklt_variants); KLT-VIO gives one point per
-  /// feature per set and is unaffected.
+  /// EKLT-VIO and HASTE-VIO on the calibrated sensors (docs/consistency.md
+  /// "EKLT on real-like events", campaign eklt_variants); KLT-VIO gives one
+  /// point per feature per set and is unaffected.
   bool drop_repeated_points = true;
   /// Mark a feature not informative until its position has moved this far
   /// from its last informative position, px (0: any motion).

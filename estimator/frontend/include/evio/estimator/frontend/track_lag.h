@@ -6,11 +6,11 @@
 /// An event track point trails the feature along its motion by
 ///   lag = a + τ |v|    (a px in distance, τ s in time, v the image velocity),
 /// measured against the simulator's truth for EKLT on the DAVIS240C
-/// (README "Tracker lag"): τ from the photoreceptor's low-pass, a from how
-/// events trail a moving edge. Both depend on the sensor and the light, so
-/// they are estimated here from the frames, whose positions do not lag: every
-/// live event-tracked feature is also followed from frame to frame by
-/// pyramidal Lucas–Kanade (its "frame position", started where the tracker
+/// (docs/consistency.md "Tracker lag"): τ from the photoreceptor's low-pass,
+/// a from how events trail a moving edge. Both depend on the sensor and the
+/// light, so they are estimated here from the frames, whose positions do not
+/// lag: every live event-tracked feature is also followed from frame to frame
+/// by pyramidal Lucas–Kanade (its "frame position", started where the tracker
 /// seeded the feature on a frame); at each frame t_k the event track,
 /// extrapolated from its last two points to t_k as the synchroniser does,
 /// is compared with the frame position s_k:
@@ -38,7 +38,7 @@ struct TrackLagOptions {
   /// Estimate the lag online and compensate it in the synchroniser (EKLT and
   /// HASTE; KLT does not lag). On: EKLT-VIO's error 1.5–4× lower and its
   /// ANEES near its bounds on the indoor analogues, unchanged in Mars
-  /// daylight (README "Tracker lag").
+  /// daylight (docs/consistency.md "Tracker lag").
   bool estimate = true;
   double memory_s = 5.0;         ///< forgetting time constant of the fit, s
   double min_speed_pxps = 20.0;  ///< slower samples (direction ill-defined) are skipped, px/s

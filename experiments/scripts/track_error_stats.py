@@ -38,14 +38,24 @@ but the point count: gross losses, which the filter's gate rejects, would
 otherwise set the RMS and the correlations. The correlation interpolates
 across the gaps they leave.
 
+With --lag-model the tracker's along-motion lag a + τ|v| is fitted and
+added back along v̂ at every point first (as track_noise_stats.py does, v the
+central difference of the true positions): what remains is the error the
+filter meets, since it compensates that lag (docs/algorithms.md "Tracker
+lag").
+
 Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
        [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
-       [--off-px 2] [--off-run 10]
+       [--off-px 2] [--off-run 10] [--lag-model] [--min-speed 50]
 """
 import argparse
+import os
 import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from track_noise_stats import remove_lag  # noqa: E402  (the lag fit the noise figures use)
 
 
 def read_points(path):
@@ -59,8 +69,16 @@ def read_points(path):
     return tracks
 
 
+def true_velocity(t, xy):
+    """px/s at each truth point: central differences, one-sided at the ends."""
+    if len(t) < 2:
+        return np.zeros_like(xy)
+    return np.stack([np.gradient(xy[:, 0], t), np.gradient(xy[:, 1], t)], axis=1)
+
+
 def errors(tracks, truth, skip_s):
-    """{id: (t[], e[n,2], age[n])}: tracked − true at the truth's times."""
+    """{id: (t[], e[n,2], age[n], v[n,2])}: tracked − true at the truth's
+    times, and the true image velocity there."""
     out = {}
     for fid, (tt, xy_true) in truth.items():
         if fid not in tracks:
@@ -69,17 +87,20 @@ def errors(tracks, truth, skip_s):
         keep = np.isin(t, tt)
         t_k, xy_k = t[keep], xy[keep]
         truth_at = {ti: xi for ti, xi in zip(tt, xy_true)}
+        v_true = true_velocity(tt, xy_true)
+        velocity_at = {ti: vi for ti, vi in zip(tt, v_true)}
         e = np.array([xy_k[i] - truth_at[ti] for i, ti in enumerate(t_k)]).reshape(-1, 2)
+        v = np.array([velocity_at[ti] for ti in t_k]).reshape(-1, 2)
         if len(t_k) < 2:
             continue
         sel = t_k >= skip_s
-        out[fid] = (t_k[sel], e[sel], (t_k - t_k[0])[sel])
+        out[fid] = (t_k[sel], e[sel], (t_k - t_k[0])[sel], v[sel])
     return out
 
 
 def correlation(errs, lag, since_start):
     num, a2, b2, n = 0.0, 0.0, 0.0, 0
-    for t, e, _ in errs.values():
+    for t, e, *_ in errs.values():
         if len(t) < 2:
             continue
         ee = e - e[0] if since_start else e
@@ -100,7 +121,7 @@ def off_runs(errs, off_px):
     """Lengths (points) of the runs of consecutive points of one track with
     |e| > off_px."""
     runs = []
-    for _, e, _ in errs.values():
+    for _, e, *_ in errs.values():
         length = 0
         for off in np.linalg.norm(e, axis=1) > off_px:
             if off:
@@ -123,14 +144,25 @@ def main():
     ap.add_argument("--max-error", type=float, default=5.0, help="leave out points with |e| above this, px")
     ap.add_argument("--off-px", type=float, default=2.0, help="a point is off beyond this |e|, px")
     ap.add_argument("--off-run", type=int, default=10, help="count runs of at least this many off points")
+    ap.add_argument("--lag-model", action="store_true", help="remove the fitted along-motion lag a + tau |v| first")
+    ap.add_argument("--min-speed", type=float, default=50.0, help="px/s: the lag fit's points (as track_lag.py)")
     a = ap.parse_args()
     errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
     if not errs:
         sys.exit("no track has a truth")
     n_all = sum(len(v[0]) for v in errs.values())
-    for fid, (t, e, age) in list(errs.items()):
+    for fid, (t, e, age, v) in list(errs.items()):
         keep = np.linalg.norm(e, axis=1) <= a.max_error
-        errs[fid] = (t[keep], e[keep], age[keep])
+        errs[fid] = (t[keep], e[keep], age[keep], v[keep])
+    if a.lag_model:
+        ids = list(errs)
+        sizes = [len(errs[fid][0]) for fid in ids]
+        e_all, lag_a, lag_tau = remove_lag(np.concatenate([errs[fid][1] for fid in ids]),
+                                           np.concatenate([errs[fid][3] for fid in ids]), a.min_speed)
+        for fid, part in zip(ids, np.split(e_all, np.cumsum(sizes)[:-1])):
+            t, _, age, v = errs[fid]
+            errs[fid] = (t, part, age, v)
+        print(f"lag removed: a = {lag_a:.3f} px, tau = {lag_tau * 1e3:.2f} ms")
     e = np.concatenate([v[1] for v in errs.values()])
     age = np.concatenate([v[2] for v in errs.values()])
     print(f"tracks {len(errs)}  points {n_all}, {len(e)} with |e| <= {a.max_error} px")

@@ -2,7 +2,8 @@
 """experiments/scripts/track_error_stats.py's tails on hand-made tracks whose
 errors are known exactly: the shares of points beyond 1, 2 and 3 px and the
 runs of consecutive points of one track beyond --off-px, counted per track
-(a run never joins two tracks) with the points past --max-error left out."""
+(a run never joins two tracks) with the points past --max-error left out;
+and the along-motion lag a + τ|v| that --lag-model fits and removes."""
 import os
 import subprocess
 import sys
@@ -60,6 +61,40 @@ class TrackErrorTails(unittest.TestCase):
             r = run(tracks, truth, "--off-run", "2")
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertIn("runs beyond 2 px: 1; 1 of at least 2 points, holding 2 points", r.stdout)
+
+
+class TrackErrorLagModel(unittest.TestCase):
+    def test_a_known_lag_is_fitted_and_removed(self):
+        # Three tracks at constant image velocity (100 px/s along x, 300 px/s
+        # along x, 200 px/s along y), each trailing its truth by exactly
+        # a + tau |v| along the motion, a = 0.5 px, tau = 2 ms: 0.7, 1.1 and
+        # 0.9 px. The least-squares fit recovers a and tau exactly, and what
+        # is left is no error at all.
+        a, tau = 0.5, 0.002
+        velocities = {1: (100.0, 0.0), 2: (300.0, 0.0), 3: (0.0, 200.0)}
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            rows_t, rows_g = [], []
+            for fid, (vx, vy) in velocities.items():
+                speed = (vx * vx + vy * vy) ** 0.5
+                lag = a + tau * speed
+                for k in range(50):
+                    t = 0.01 * k
+                    x, y = 20.0 + vx * t, 30.0 + vy * t
+                    rows_g.append((fid, t, x, y))
+                    rows_t.append((fid, t, x - lag * vx / speed, y - lag * vy / speed))
+            write(tracks, rows_t)
+            write(truth, rows_g)
+            plain = run(tracks, truth)
+            self.assertEqual(plain.returncode, 0, plain.stderr)
+            # Without the model the error is the lag: RMS along x over the
+            # 150 points sqrt((50 * 0.7² + 50 * 1.1²) / 150) = 0.753 px, along y
+            # sqrt(50 * 0.9² / 150) = 0.520 px.
+            self.assertIn("RMS error x 0.753 px  y 0.520 px", plain.stdout)
+            r = run(tracks, truth, "--lag-model")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("lag removed: a = 0.500 px, tau = 2.00 ms", r.stdout)
+            self.assertIn("RMS error x 0.000 px  y 0.000 px", r.stdout)
 
 
 if __name__ == "__main__":

@@ -38,6 +38,16 @@ but the point count: gross losses, which the filter's gate rejects, would
 otherwise set the RMS and the correlations. The correlation interpolates
 across the gaps they leave.
 
+With --common-bin W the errors shared by the features at one time are
+measured: time is cut into bins of W s, each feature's errors in a bin are
+averaged, and for every bin with at least --common-min-features features the
+mean over the features m (px) and the spread s² of the features around it
+(per axis, divisor n − 1) are taken. Printed: the mean over the bins of
+|m|²/2 (the per-axis variance of the all-feature mean), the same expected if
+the features' errors were independent (mean of s²/n), and their ratio. A
+ratio well above 1 is an error common to the features (a shared shift of
+the image) that averaging over features cannot remove.
+
 With --lag-model the tracker's along-motion lag a + τ|v| is fitted and
 added back along v̂ at every point first (as track_noise_stats.py does, v the
 central difference of the true positions): what remains is the error the
@@ -47,6 +57,7 @@ lag").
 Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
        [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
        [--off-px 2] [--off-run 10] [--lag-model] [--min-speed 50]
+       [--common-bin 0.01] [--common-min-features 8]
 """
 import argparse
 import os
@@ -134,6 +145,33 @@ def off_runs(errs, off_px):
     return np.array(runs, dtype=int)
 
 
+def common_mode(errs, bin_s, min_features):
+    """(bins used, median features per bin, mean |m|²/2, mean s²/n): the
+    per-axis variance of the bins' all-feature mean error and what it would
+    be with independent errors (see the module comment)."""
+    per_bin = {}
+    for t, e, *_ in errs.values():
+        if len(t) == 0:
+            continue
+        bins = np.floor(t / bin_s).astype(np.int64)
+        for b in np.unique(bins):
+            per_bin.setdefault(int(b), []).append(e[bins == b].mean(axis=0))
+    common, independent, sizes = [], [], []
+    for b in sorted(per_bin):
+        feature_means = np.array(per_bin[b])
+        n = len(feature_means)
+        if n < min_features:
+            continue
+        m = feature_means.mean(axis=0)
+        spread = np.sum((feature_means - m) ** 2) / (2 * (n - 1))  # per axis
+        common.append(float(np.dot(m, m)) / 2)
+        independent.append(spread / n)
+        sizes.append(n)
+    if not common:
+        return 0, 0, float("nan"), float("nan")
+    return len(common), float(np.median(sizes)), float(np.mean(common)), float(np.mean(independent))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("tracks")
@@ -146,6 +184,8 @@ def main():
     ap.add_argument("--off-run", type=int, default=10, help="count runs of at least this many off points")
     ap.add_argument("--lag-model", action="store_true", help="remove the fitted along-motion lag a + tau |v| first")
     ap.add_argument("--min-speed", type=float, default=50.0, help="px/s: the lag fit's points (as track_lag.py)")
+    ap.add_argument("--common-bin", type=float, default=0.0, help="s: measure the error common to the features (0: off)")
+    ap.add_argument("--common-min-features", type=int, default=8, help="bins with fewer features are left out")
     a = ap.parse_args()
     errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
     if not errs:
@@ -197,6 +237,11 @@ def main():
         c, n = correlation(errs, lag, False)
         c0, _ = correlation(errs, lag, True)
         print(f"{lag:7.3f}  {c:9.3f}  {n:8d}  {c0:9.3f}")
+    if a.common_bin > 0:
+        bins, features, common, independent = common_mode(errs, a.common_bin, a.common_min_features)
+        print(f"common to the features, bins of {a.common_bin * 1e3:g} ms: {bins} bins, {features:g} features per bin; "
+              f"all-feature mean {common:.4f} px² per axis, {independent:.4f} if independent, "
+              f"ratio {common / independent:.2f}")
 
 
 if __name__ == "__main__":

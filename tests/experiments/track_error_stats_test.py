@@ -3,7 +3,8 @@
 errors are known exactly: the shares of points beyond 1, 2 and 3 px and the
 runs of consecutive points of one track beyond --off-px, counted per track
 (a run never joins two tracks) with the points past --max-error left out;
-and the along-motion lag a + τ|v| that --lag-model fits and removes."""
+the along-motion lag a + τ|v| that --lag-model fits and removes; and the
+error common to the features at one time (--common-bin)."""
 import os
 import subprocess
 import sys
@@ -95,6 +96,36 @@ class TrackErrorLagModel(unittest.TestCase):
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertIn("lag removed: a = 0.500 px, tau = 2.00 ms", r.stdout)
             self.assertIn("RMS error x 0.000 px  y 0.000 px", r.stdout)
+
+
+class TrackErrorCommonMode(unittest.TestCase):
+    def test_a_shift_shared_by_every_feature_is_measured_exactly(self):
+        # Ten still features, one point each in four 10 ms bins. Along x every
+        # feature carries the bin's common shift (+0.3, -0.3, +0.3, -0.3 px)
+        # plus its own +0.4 px (features 0-4) or -0.4 px (5-9); y is exact.
+        # Per bin: the all-feature mean is (±0.3, 0), |m|²/2 = 0.045 px²; the
+        # spread around it, per axis with divisor n - 1, is
+        # 10 · 0.4² / (2 · 9) = 0.0889 px², and 0.0889 / 10 = 0.0089 px² is what
+        # the mean's variance would be with independent errors: ratio 5.06.
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            rows_t, rows_g = [], []
+            for fid in range(10):
+                own = 0.4 if fid < 5 else -0.4
+                for b, shift in enumerate((0.3, -0.3, 0.3, -0.3)):
+                    t = 0.005 + 0.01 * b
+                    rows_g.append((fid, t, 20.0 * fid, 50.0))
+                    rows_t.append((fid, t, 20.0 * fid + shift + own, 50.0))
+            write(tracks, rows_t)
+            write(truth, rows_g)
+            r = run(tracks, truth, "--common-bin", "0.01")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("common to the features, bins of 10 ms: 4 bins, 10 features per bin; "
+                          "all-feature mean 0.0450 px² per axis, 0.0089 if independent, ratio 5.06", r.stdout)
+            # With a minimum of 11 features per bin no bin qualifies.
+            r = run(tracks, truth, "--common-bin", "0.01", "--common-min-features", "11")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("0 bins", r.stdout)
 
 
 if __name__ == "__main__":

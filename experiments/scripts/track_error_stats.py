@@ -187,6 +187,8 @@ def main():
     ap.add_argument("--common-bin", type=float, default=0.0, help="s: measure the error common to the features (0: off)")
     ap.add_argument("--common-min-features", type=int, default=8, help="bins with fewer features are left out")
     a = ap.parse_args()
+    if a.common_min_features < 2:
+        sys.exit("track_error_stats: --common-min-features must be at least 2 (a spread needs two features)")
     errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
     if not errs:
         sys.exit("no track has a truth")

@@ -126,6 +126,10 @@ class TrackErrorCommonMode(unittest.TestCase):
             r = run(tracks, truth, "--common-bin", "0.01", "--common-min-features", "11")
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertIn("0 bins", r.stdout)
+            # One feature has no spread: refused with one clear line.
+            r = run(tracks, truth, "--common-bin", "0.01", "--common-min-features", "1")
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--common-min-features must be at least 2", r.stderr)
 
 
 if __name__ == "__main__":

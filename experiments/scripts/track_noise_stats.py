@@ -83,7 +83,7 @@ def remove_lag(e, v, min_speed):
     lag = -np.sum(e * u, axis=1)
     fast = speed >= min_speed
     if fast.sum() < 2:
-        sys.exit(f"track_noise_stats: fewer than two points faster than {min_speed:g} px/s to fit the lag")
+        sys.exit(f"{os.path.basename(sys.argv[0])}: fewer than two points faster than {min_speed:g} px/s to fit the lag")
     a, tau = fitLag(list(zip(speed[fast], lag[fast])))
     return e + ((a + tau * speed) * moving)[:, None] * u, a, tau
 

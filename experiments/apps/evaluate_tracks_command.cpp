@@ -86,6 +86,10 @@ void addEvaluateTracksCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing on success");
   cmd->callback([args] {
     namespace fs = std::filesystem;
+    const fs::path out(args->output);
+    // Checked first: a bad name must not leave a --truth-output behind.
+    if (out.extension() != ".json" && out.extension() != ".csv")
+      throw Error("--output: must end in .json or .csv (got '" + args->output + "')");
     const bool folder = fs::is_directory(args->truth);
     std::string mode = args->mode;
     if (mode == "auto") mode = folder && fs::exists(fs::path(args->truth) / "truth" / "depth.txt") ? "depth" : "tracks";
@@ -112,15 +116,12 @@ void addEvaluateTracksCommand(CLI::App& app) {
       const std::string truth_file = folder ? (fs::path(args->truth) / "truth" / "tracks.txt").string() : args->truth;
       metrics = experiments::evaluateTracks(estimated, io::readTracksText(truth_file), args->options);
     }
-    const fs::path out(args->output);
     if (out.extension() == ".json") {
       io::writeFileAtomic(args->output, experiments::trackMetricsJson(metrics));
-    } else if (out.extension() == ".csv") {
+    } else {
       io::writeFileAtomic(args->output, experiments::errorVsAgeCsv(metrics));
       io::writeFileAtomic((out.parent_path() / (out.stem().string() + "_alive.csv")).string(),
                           experiments::aliveCsv(metrics));
-    } else {
-      throw Error("--output: must end in .json or .csv (got '" + args->output + "')");
     }
     if (!args->quiet)
       std::printf("%s: %llu of %llu tracks evaluable; mean error %.3f px (median %.3f); mean feature age %.3f s "

@@ -1,9 +1,11 @@
 // `evio track <sequence> --frontend eklt|klt|haste [--image-source frames|reconstructed]
-//  [--config file] [--set key=value] [--noise] -o tracks.txt`: runs a
+//  [--config file] [--set key=value] [--noise] [--lag-compensated] -o tracks.txt`: runs a
 // feature-tracking frontend over a sequence folder and writes its tracks
 // (id t x y), with the resolved configuration beside them (<output>.yaml)
 // and, with --noise, what the tracker stated with each point
-// (<output>.noise.txt: id t quality cov_xx cov_xy cov_yy, px²).
+// (<output>.noise.txt: id t quality cov_xx cov_xy cov_yy, px²); with
+// --lag-compensated, the points as the filter is given them
+// (<output>.lag_compensated.txt, id t x y).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -28,6 +30,8 @@ void addTrackCommand(CLI::App& app) {
     std::vector<std::string> overrides;
     std::string output;
     bool noise = false;
+    bool lag_compensated = false;
+    double lag_velocity_window_s = 0.0;
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
@@ -43,6 +47,13 @@ void addTrackCommand(CLI::App& app) {
   cmd->add_flag("--noise", args->noise,
                 "also write <output>.noise.txt: each point's quality and position covariance (id t quality cov_xx "
                 "cov_xy cov_yy, px^2)");
+  cmd->add_flag("--lag-compensated", args->lag_compensated,
+                "also write <output>.lag_compensated.txt (id t x y): each point moved forward by the lag estimated "
+                "online from the frames so far, as the filter is given it (EKLT, HASTE)");
+  cmd->add_option("--lag-velocity-window", args->lag_velocity_window_s,
+                  "with --lag-compensated: each track's velocity fitted over its points of this last span, s (the "
+                  "synchroniser's velocity_window_s; 0: its newest two points)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("-q,--quiet", args->quiet, "no progress line or summary");
   cmd->callback([args] {
     io::requireNotStaging(args->folder);
@@ -55,9 +66,11 @@ void addTrackCommand(CLI::App& app) {
     config::fill(doc, "", options);
 
     ProgressLine progress("tracking", "ev", args->quiet);
-    const auto result = experiments::trackSequence(args->folder, options, [&](double fraction, std::uint64_t events) {
-      progress.update(fraction, static_cast<double>(events));
-    });
+    const auto result = experiments::trackSequence(
+        args->folder, options,
+        [&](double fraction, std::uint64_t events) { progress.update(fraction, static_cast<double>(events)); },
+        args->lag_compensated ? std::optional(experiments::LagCompensation{args->lag_velocity_window_s})
+                              : std::nullopt);
     progress.finish();
     io::StagedFiles staged(args->output);  // the tracks and their .yaml published together
     io::writeTracksText(staged.path(args->output), result.samples,
@@ -72,6 +85,14 @@ void addTrackCommand(CLI::App& app) {
                                "id t quality cov_xx cov_xy cov_yy"});
     } else {
       staged.drop(noise_file);  // an older run's noise would not belong to these tracks
+    }
+    const std::string compensated_file = args->output + ".lag_compensated.txt";
+    if (args->lag_compensated) {
+      io::writeTracksText(staged.path(compensated_file), result.compensated,
+                          {"the points of " + args->output + " moved forward by the lag estimated online so far",
+                           "(as the filter is given them; unmoved before the estimate exists)", "id t x y"});
+    } else {
+      staged.drop(compensated_file);  // an older run's would not belong to these tracks
     }
     staged.publish();
     if (!args->quiet)

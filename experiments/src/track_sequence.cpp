@@ -15,6 +15,7 @@
 #include "evio/core/io/sensors_yaml.h"
 #include "evio/core/stopwatch.h"
 #include "evio/estimator/frontend/event_prefilter.h"
+#include "evio/estimator/frontend/track_velocity.h"
 #include "evio/experiments/sequence_info.h"
 
 namespace evio::experiments {
@@ -133,8 +134,14 @@ estimator::Frontend frontendFor(const std::string& folder, const estimator::Fron
 
 }  // namespace
 
+Vec2 lagCompensated(const estimator::TrackLag& lag, const Vec2& uv, const Vec2& velocity) {
+  const double speed = velocity.norm();
+  if (!(speed > 0.0)) return uv;
+  return uv + lag.tau_s * velocity + lag.a_px * (velocity / speed);
+}
+
 TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& requested,
-                                  const TrackProgress& progress) {
+                                  const TrackProgress& progress, std::optional<LagCompensation> compensate_lag) {
   requested.validate();
   if (!fs::is_directory(folder)) throw Error(folder + ": not a folder");
   const bool has_images = fs::exists(fs::path(folder) / "images.txt");
@@ -162,9 +169,19 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   result.camera_name = cam.name;
   result.options = options;
   std::unordered_map<std::int64_t, TimeNs> last_t;
+  std::unordered_map<std::int64_t, estimator::TrackVelocity> velocities;  // per track (compensate_lag)
   estimator::TrackPoints points;
   std::size_t next_imu = 0;
   double busy = 0.0;
+  const auto compensate = [&](const io::TrackSample& sample) {
+    io::TrackSample out = sample;
+    auto [it, inserted] = velocities.try_emplace(sample.id, compensate_lag->velocity_window_s);
+    it->second.add(sample.t_ns, sample.uv);
+    const auto lag = frontend.trackLag();  // the estimate as the points leave the frontend
+    const auto v = it->second.velocity();
+    if (lag && v) out.uv = lagCompensated(*lag, sample.uv, *v);
+    result.compensated.push_back(out);
+  };
   const auto collect = [&] {
     points.clear();
     frontend.drainTrackPoints(points);
@@ -177,6 +194,7 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
       }
       result.samples.push_back(io::TrackSample{p.feature_id, p.t_ns, p.uv});
       result.noise.push_back(io::TrackNoiseSample{p.feature_id, p.t_ns, p.quality, p.cov_px});
+      if (compensate_lag) compensate(result.samples.back());
     }
   };
   const auto feedImuUntil = [&](TimeNs t) {

@@ -3,7 +3,10 @@
 the sidecar <output>.noise.txt has one line per track point, in the same
 order with the same id and stamp, a quality in [0, 1] and a covariance that
 is zero (not stated) or positive definite; a run without --noise removes an
-older sidecar, which would not belong to the new tracks.
+older sidecar, which would not belong to the new tracks. The same for
+--lag-compensated (<output>.lag_compensated.txt: id t x y, the same ids and
+stamps). `evio evaluate-tracks` with a metrics name it cannot write fails
+before it writes a --truth-output.
 
 usage: track_noise_output_test.py <evio> <source dir>"""
 import os
@@ -46,6 +49,32 @@ class TrackNoiseOutput(unittest.TestCase):
             r = subprocess.run(args, capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertFalse(os.path.exists(out + ".noise.txt"))
+
+    def test_lag_compensated_sidecar_follows_the_tracks(self):
+        folder = os.path.join(SOURCE, "tests", "data", "ecd", "shapes_rotation_events")
+        with tempfile.TemporaryDirectory() as root:
+            out = os.path.join(root, "t.txt")
+            args = [EVIO, "track", folder, "--frontend", "eklt", "--image-source", "reconstructed", "-q", "-o", out]
+            r = subprocess.run(args + ["--lag-compensated", "--lag-velocity-window", "0.02"],
+                               capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            tracks, moved = data_lines(out), data_lines(out + ".lag_compensated.txt")
+            self.assertGreater(len(tracks), 50)
+            self.assertEqual([m[:2] for m in moved], [t[:2] for t in tracks])
+            r = subprocess.run(args + ["--lag-velocity-window", "2"], capture_output=True, text=True)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--lag-velocity-window", r.stderr)
+            r = subprocess.run(args, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertFalse(os.path.exists(out + ".lag_compensated.txt"))
+            # A metrics name evaluate-tracks cannot write: one error, nothing written.
+            truth_out = os.path.join(root, "truth.txt")
+            r = subprocess.run([EVIO, "evaluate-tracks", out, out, "--truth-output", truth_out,
+                                "-o", os.path.join(root, "m.txt")], capture_output=True, text=True)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--output: must end in .json or .csv", r.stderr)
+            self.assertFalse(os.path.exists(truth_out))
+            self.assertEqual(sorted(os.listdir(root)), ["t.txt", "t.txt.yaml"])
 
 
 if __name__ == "__main__":

@@ -144,6 +144,44 @@ TEST(TrackSequence, ReconstructedFramesDriveEklt) {
   EXPECT_LT(m.mean_error_px, 1.0);
 }
 
+// The lag moved out of a point: τ times its velocity plus a along it. At
+// (300, 400) px/s, |v| = 500 px/s, with τ = 2 ms and a = 0.5 px the point
+// (3, 4) moves by (0.6, 0.8) + (0.3, 0.4) px. A still point stays.
+TEST(TrackSequence, LagCompensationMovesAPointAlongItsMotion) {
+  const estimator::TrackLag lag{0.5, 0.002};
+  const Vec2 moved = lagCompensated(lag, Vec2(3, 4), Vec2(300, 400));
+  EXPECT_NEAR(moved.x(), 3.9, 1e-12);
+  EXPECT_NEAR(moved.y(), 5.2, 1e-12);
+  EXPECT_EQ(lagCompensated(lag, Vec2(3, 4), Vec2::Zero()), Vec2(3, 4));
+}
+
+// --lag-compensated gives one point per tracked point, same ids and times;
+// without an online estimate (track_lag.estimate off) nothing moves.
+TEST(TrackSequence, LagCompensatedPointsMatchTheTrackedOnes) {
+  SyntheticSequence seq;
+  for (const bool estimate : {true, false}) {
+    estimator::FrontendOptions o;
+    o.eklt.batch_contrast_threshold = 0.02;
+    o.eklt.batch_max_events = 5000;
+    o.eklt.max_features = 10;
+    o.eklt.min_features = 5;
+    o.eklt.harris_quality_level = 0.05;
+    o.track_lag.estimate = estimate;
+    const TrackSequenceResult r = trackSequence(seq.folder(), o, {}, LagCompensation{0.02});
+    ASSERT_EQ(r.compensated.size(), r.samples.size());
+    ASSERT_GT(r.samples.size(), 20u);
+    for (std::size_t i = 0; i < r.samples.size(); ++i) {
+      EXPECT_EQ(r.compensated[i].id, r.samples[i].id);
+      EXPECT_EQ(r.compensated[i].t_ns, r.samples[i].t_ns);
+      if (!estimate) {
+        EXPECT_EQ(r.compensated[i].uv, r.samples[i].uv);
+      }
+    }
+  }
+  estimator::FrontendOptions o;
+  EXPECT_TRUE(trackSequence(seq.folder(), o).compensated.empty()) << "filled only when asked";
+}
+
 TEST(TrackSequence, MissingInputsAreErrors) {
   test::TempDir dir;
   EXPECT_THROW(trackSequence(dir.file("nope"), {}), Error);

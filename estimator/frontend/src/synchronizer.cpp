@@ -18,6 +18,7 @@ void SynchronizerOptions::validate() const {
   requireInRange("min_displacement_px", min_displacement_px, 0.0, 100.0);
   requireInRange("track_latency_s", track_latency_s, 0.0, 0.05);
   requireInRange("track_lag_px", track_lag_px, 0.0, 10.0);
+  requireInRange("velocity_window_s", velocity_window_s, 0.0, 1.0);
 }
 
 Synchronizer::Synchronizer(const SynchronizerOptions& options) : options_(options) {
@@ -37,8 +38,12 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
       continue;
     }
     auto [it, inserted] = tracks_.try_emplace(p.feature_id);
-    if (inserted) order_.push_back(p.feature_id);
+    if (inserted) {
+      order_.push_back(p.feature_id);
+      it->second.velocity = TrackVelocity(options_.velocity_window_s);
+    }
     Track& tr = it->second;
+    if (options_.velocity_window_s > 0.0) tr.velocity.add(p.t_ns, p.uv);
     if (tr.n > 0 && p.t_ns <= tr.t[1]) {  // same time: replace the newest point; older: ignore
       if (p.t_ns == tr.t[1]) {
         tr.uv[1] = p.uv;
@@ -117,6 +122,14 @@ Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
   if (tr.n < 2 || tr.t[1] == tr.t[0]) return tr.uv[1];
   const TimeNs horizon = secondsToNs(options_.max_extrapolation_s);
   const TimeNs t = std::min(t_ns, tr.t[1] + horizon);
+  if (options_.velocity_window_s > 0.0) {
+    if (const auto v = tr.velocity.velocity()) {
+      // uv1 + v (t − t1) + a v/|v|: the newest point moved along the fitted velocity.
+      const double speed = v->norm();
+      const Vec2 lag = speed > 0.0 ? Vec2(lag_px_ / speed * *v) : Vec2::Zero();
+      return tr.uv[1] + nsToSeconds(t - tr.t[1]) * *v + lag;
+    }
+  }
   const Vec2 step = tr.uv[1] - tr.uv[0];
   const double length = step.norm();
   // The lag in distance, a px along the direction of the last step.

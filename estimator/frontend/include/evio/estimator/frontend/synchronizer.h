@@ -21,7 +21,8 @@
 /// Independently, min_rate_hz > 0 forces an update when no update happened
 /// for 1/min_rate_hz seconds of data time (scenes without events).
 /// At an update every live track is linearly extrapolated to the update time
-/// from its last two points (held when it has one; at most
+/// from its last two points, or along the velocity fitted over its last
+/// velocity_window_s (held when it has one point; at most
 /// max_extrapolation_s beyond its last point), and carries the position it
 /// was sent with at the previous update and the covariance and error time
 /// constant its tracker stated for its newest point.
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "evio/core/options.h"
+#include "evio/estimator/frontend/track_velocity.h"
 #include "evio/estimator/measurements.h"
 
 namespace evio::estimator {
@@ -63,6 +65,11 @@ struct SynchronizerOptions {
   /// points), whatever the speed; each sent position is moved forward by it.
   /// With track_latency_s = τ the lag of a point is a + τ |v|. 0: none.
   double track_lag_px = 0.0;
+  /// The velocity that moves a point forward (by the lag and to the set's
+  /// time), s: fitted over the track's points of the last this many seconds
+  /// (track_velocity.h), always its newest two at least. 0: the slope of its
+  /// newest two points alone.
+  double velocity_window_s = 0.0;
 
   template <class V>
   void fields(V& v) {
@@ -75,6 +82,7 @@ struct SynchronizerOptions {
     v("min_displacement_px", min_displacement_px, "motion since the last informative position, px");
     v("track_latency_s", track_latency_s, "tracker latency compensated along the track's velocity, s");
     v("track_lag_px", track_lag_px, "tracker lag along the track's direction compensated, px");
+    v("velocity_window_s", velocity_window_s, "the track velocity is fitted over its points of this last span, s (0: last two)");
   }
   void validate() const;
 };
@@ -120,6 +128,7 @@ class Synchronizer {
     bool moved = true;
     bool sent = false;
     Vec2 last_sent = Vec2::Zero();
+    TrackVelocity velocity;   // fitted over velocity_window_s (kept only when it is > 0)
   };
   enum class Trigger { kEvents, kFixedRate, kTrackTime };
   Vec2 extrapolate(const Track& track, TimeNs t_ns) const;

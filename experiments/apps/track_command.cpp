@@ -90,7 +90,8 @@ void addTrackCommand(CLI::App& app) {
     if (args->lag_compensated) {
       io::writeTracksText(staged.path(compensated_file), result.compensated,
                           {"the points of " + args->output + " moved forward by the lag estimated online so far",
-                           "(as the filter is given them; unmoved before the estimate exists)", "id t x y"});
+                           "(as the filter is given them; unmoved before the estimate exists)",
+                           "pixels of camera " + result.camera_name, "id t x y"});
     } else {
       staged.drop(compensated_file);  // an older run's would not belong to these tracks
     }

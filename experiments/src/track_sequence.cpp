@@ -186,7 +186,10 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
     points.clear();
     frontend.drainTrackPoints(points);
     for (const auto& p : points) {
-      if (p.status == estimator::TrackStatus::kLost) continue;
+      if (p.status == estimator::TrackStatus::kLost) {
+        velocities.erase(p.feature_id);  // as the synchroniser forgets a lost track
+        continue;
+      }
       auto [it, inserted] = last_t.try_emplace(p.feature_id, p.t_ns);
       if (!inserted) {
         if (p.t_ns <= it->second) continue;  // a track's times must increase in tracks.txt

@@ -150,7 +150,8 @@ TEST(Synchronizer, CompensatesALagInDistanceAndTimeAtAnySpeed) {
     return point(id, t, linear(uv0, v, t - tau) - a * v.normalized(), st);
   };
   // The velocity from the newest two points or fitted over 20 ms (all three
-  // points here) is the same on a line; the set's time is 1 ms after them.
+  // points here) is the same on a line; the set comes at 15 ms, 1 ms after
+  // the slow track's newest point (extrapolated) and at the fast one's.
   for (const double window : {0.0, 0.02}) {
     SynchronizerOptions o;
     o.n_e = 10;

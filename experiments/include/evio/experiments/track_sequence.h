@@ -36,6 +36,13 @@ struct TrackSequenceResult {
 /// Called with the share of events read (0..1) and the number read.
 using TrackProgress = std::function<void(double fraction, std::uint64_t events)>;
 
+/// What trackSequence's `compensate_lag` asks for: each track's velocity
+/// fitted over this window, s (synchronizer.h velocity_window_s; 0: its
+/// newest two points).
+struct LagCompensation {
+  double velocity_window_s = 0.0;
+};
+
 /// The camera comes from sensors.yaml (EKLT: the event camera, KLT: the
 /// frame camera when there is one) or else from calib.txt with the size of
 /// the first frame. Events from events.h5 when present, else events.txt.
@@ -43,11 +50,8 @@ using TrackProgress = std::function<void(double fraction, std::uint64_t events)>
 /// Throws evio::Error for a missing or malformed input.
 /// With `compensate_lag`, also fills `compensated`: what the filter is
 /// given for each point once the frontend's online lag estimate (track_lag)
-/// exists, with each track's velocity fitted over the stated window
-/// (synchronizer.h velocity_window_s; 0: its newest two points).
-struct LagCompensation {
-  double velocity_window_s = 0.0;
-};
+/// exists. Unlike the synchroniser, a second point at a track's newest time
+/// is dropped (tracks.txt needs increasing times), not put in its place.
 TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& options,
                                   const TrackProgress& progress = {},
                                   std::optional<LagCompensation> compensate_lag = std::nullopt);

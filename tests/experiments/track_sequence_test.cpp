@@ -51,16 +51,22 @@ struct SyntheticSequence {
   }
 };
 
+/// EKLT settings for SyntheticSequence's few sharp blobs: its contrast,
+/// batches and detector.
+void setEkltForTheBlobs(estimator::FrontendOptions& o) {
+  o.eklt.batch_contrast_threshold = 0.02;
+  o.eklt.batch_max_events = 5000;
+  o.eklt.max_features = 10;
+  o.eklt.min_features = 5;
+  o.eklt.harris_quality_level = 0.05;
+}
+
 TEST(TrackSequence, EkltAndKltTrackASyntheticSequence) {
   SyntheticSequence seq;
   for (const char* tracker : {"eklt", "klt"}) {
     estimator::FrontendOptions o;
     o.tracker = tracker;
-    o.eklt.batch_contrast_threshold = 0.02;
-    o.eklt.batch_max_events = 5000;
-    o.eklt.max_features = 10;
-    o.eklt.min_features = 5;
-    o.eklt.harris_quality_level = 0.05;
+    setEkltForTheBlobs(o);
     const TrackSequenceResult r = trackSequence(seq.folder(), o);
     EXPECT_EQ(r.frames, 7u);
     EXPECT_GT(r.events, 10000u);
@@ -83,11 +89,7 @@ TEST(TrackSequence, EachSampleCarriesItsTrackersQualityAndCovariance) {
   SyntheticSequence seq;
   for (const double cost_ref : {0.0, 0.005}) {  // the fits here cost 0.002-0.014
     estimator::FrontendOptions o;
-    o.eklt.batch_contrast_threshold = 0.02;
-    o.eklt.batch_max_events = 5000;
-    o.eklt.max_features = 10;
-    o.eklt.min_features = 5;
-    o.eklt.harris_quality_level = 0.05;
+    setEkltForTheBlobs(o);
     o.eklt.position_sigma_cost_ref = cost_ref;
     const TrackSequenceResult r = trackSequence(seq.folder(), o);
     ASSERT_EQ(r.noise.size(), r.samples.size());
@@ -130,11 +132,7 @@ TEST(TrackSequence, ReconstructedFramesDriveEklt) {
   o.image_source = "reconstructed";
   o.reconstruction.contrast_threshold = 0.02;
   o.reconstruction.output_every_events = 20000;
-  o.eklt.batch_contrast_threshold = 0.02;
-  o.eklt.batch_max_events = 5000;
-  o.eklt.max_features = 10;
-  o.eklt.min_features = 5;
-  o.eklt.harris_quality_level = 0.05;
+  setEkltForTheBlobs(o);
   const TrackSequenceResult r = trackSequence(seq.folder(), o);
   EXPECT_GT(r.reconstructed_frames, 3u);
   EXPECT_GE(r.tracks, 3u);
@@ -163,11 +161,7 @@ TEST(TrackSequence, LagCompensatedPointsMatchTheTrackedOnes) {
   SyntheticSequence seq;
   for (const bool estimate : {true, false}) {
     estimator::FrontendOptions o;
-    o.eklt.batch_contrast_threshold = 0.02;
-    o.eklt.batch_max_events = 5000;
-    o.eklt.max_features = 10;
-    o.eklt.min_features = 5;
-    o.eklt.harris_quality_level = 0.05;
+    setEkltForTheBlobs(o);
     o.track_lag.estimate = estimate;
     o.track_lag.min_samples = 1;  // seven frames: an estimate from the first samples
     const TrackSequenceResult r = trackSequence(seq.folder(), o, {}, LagCompensation{0.02});

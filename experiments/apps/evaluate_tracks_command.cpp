@@ -86,9 +86,9 @@ void addEvaluateTracksCommand(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing on success");
   cmd->callback([args] {
     namespace fs = std::filesystem;
-    const fs::path out(args->output);
+    const fs::path metrics_path(args->output);
     // Checked first: a bad name must not leave a --truth-output behind.
-    if (out.extension() != ".json" && out.extension() != ".csv")
+    if (metrics_path.extension() != ".json" && metrics_path.extension() != ".csv")
       throw Error("--output: must end in .json or .csv (got '" + args->output + "')");
     const bool folder = fs::is_directory(args->truth);
     std::string mode = args->mode;
@@ -116,11 +116,11 @@ void addEvaluateTracksCommand(CLI::App& app) {
       const std::string truth_file = folder ? (fs::path(args->truth) / "truth" / "tracks.txt").string() : args->truth;
       metrics = experiments::evaluateTracks(estimated, io::readTracksText(truth_file), args->options);
     }
-    if (out.extension() == ".json") {
+    if (metrics_path.extension() == ".json") {
       io::writeFileAtomic(args->output, experiments::trackMetricsJson(metrics));
     } else {
       io::writeFileAtomic(args->output, experiments::errorVsAgeCsv(metrics));
-      io::writeFileAtomic((out.parent_path() / (out.stem().string() + "_alive.csv")).string(),
+      io::writeFileAtomic((metrics_path.parent_path() / (metrics_path.stem().string() + "_alive.csv")).string(),
                           experiments::aliveCsv(metrics));
     }
     if (!args->quiet)

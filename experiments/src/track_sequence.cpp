@@ -135,9 +135,7 @@ estimator::Frontend frontendFor(const std::string& folder, const estimator::Fron
 }  // namespace
 
 Vec2 lagCompensated(const estimator::TrackLag& lag, const Vec2& uv, const Vec2& velocity) {
-  const double speed = velocity.norm();
-  if (!(speed > 0.0)) return uv;
-  return uv + lag.tau_s * velocity + lag.a_px * (velocity / speed);
+  return estimator::moveAlongVelocity(uv, velocity, lag.tau_s, lag.a_px);
 }
 
 TrackSequenceResult trackSequence(const std::string& folder, const estimator::FrontendOptions& requested,

@@ -123,12 +123,8 @@ Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
   const TimeNs horizon = secondsToNs(options_.max_extrapolation_s);
   const TimeNs t = std::min(t_ns, tr.t[1] + horizon);
   if (options_.velocity_window_s > 0.0) {
-    if (const auto v = tr.velocity.velocity()) {
-      // uv1 + v (t − t1) + a v/|v|: the newest point moved along the fitted velocity.
-      const double speed = v->norm();
-      const Vec2 lag = speed > 0.0 ? Vec2(lag_px_ / speed * *v) : Vec2::Zero();
-      return tr.uv[1] + nsToSeconds(t - tr.t[1]) * *v + lag;
-    }
+    // uv1 + v (t − t1) + a v/|v|: the newest point moved along the fitted velocity.
+    if (const auto v = tr.velocity.velocity()) return moveAlongVelocity(tr.uv[1], *v, nsToSeconds(t - tr.t[1]), lag_px_);
   }
   const Vec2 step = tr.uv[1] - tr.uv[0];
   const double length = step.norm();

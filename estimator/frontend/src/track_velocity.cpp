@@ -4,6 +4,12 @@
 
 namespace evio::estimator {
 
+Vec2 moveAlongVelocity(const Vec2& uv, const Vec2& velocity, double dt_s, double distance_px) {
+  const double speed = velocity.norm();
+  if (!(speed > 0.0)) return uv;
+  return uv + dt_s * velocity + (distance_px / speed) * velocity;
+}
+
 TrackVelocity::TrackVelocity(double window_s) : window_ns_(secondsToNs(window_s)) {
   requireInRange("velocity_window_s", window_s, 0.0, 1.0);
 }

@@ -22,6 +22,12 @@
 
 namespace evio::estimator {
 
+/// A track's point uv moved along its velocity v (px/s) by dt seconds and a
+/// further `distance_px` along v/|v|: uv + dt v + distance v/|v| (a still
+/// track, v = 0: uv). The synchroniser's extrapolation and lag compensation
+/// (synchronizer.h) and `evio track --lag-compensated` both move points so.
+Vec2 moveAlongVelocity(const Vec2& uv, const Vec2& velocity, double dt_s, double distance_px);
+
 class TrackVelocity {
  public:
   /// `window_s` >= 0: the span of points the slope is fitted over, s.

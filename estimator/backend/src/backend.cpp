@@ -75,6 +75,12 @@ void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 
   state_.imu = state;
   state_.imu.q_W_B.normalize();
   state_.P = 0.5 * (P0 + P0.transpose());
+  if (options_.slam_image_shift_sigma_px > 0.0) {
+    const Vec4 k = sensors_.camera.intrinsics();  // fx fy cx cy: normalised = px / f
+    const double s = options_.slam_image_shift_sigma_px;
+    state_.addImageShift(Vec2(s * s / (k(0) * k(0)), s * s / (k(1) * k(1))).asDiagonal(),
+                         options_.slam_image_shift_time_s);
+  }
   fej_imu_ = state_.imu;
   initialized_ = true;
   tracks_.clear();

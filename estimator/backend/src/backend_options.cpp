@@ -54,6 +54,9 @@ void BackendOptions::validate() const {
   requireInRange("slam_bearing_walk_px2_per_s", slam_bearing_walk_px2_per_s, 0.0, 1e6);
   requireInRange("slam_track_error_sigma_px", slam_track_error_sigma_px, 0.0, 100.0);
   requirePositive("slam_track_error_time_s", slam_track_error_time_s);
+  requireInRange("slam_image_shift_sigma_px", slam_image_shift_sigma_px, 0.0, 100.0);
+  requireField(slam_image_shift_time_s > 0.0 && slam_image_shift_time_s <= 60.0, "slam_image_shift_time_s",
+               "must be in (0, 60]");
   requireField(msckf_min_track_length >= 2, "msckf_min_track_length", "must be >= 2");
   requireNonNegative("min_parallax_px", min_parallax_px);
   requireNonNegative("slam_min_parallax_px", slam_min_parallax_px);

@@ -21,6 +21,7 @@ void Backend::processMeasurementSet(const MeasurementSet& set) {
     const double dt_s = nsToSeconds(state_.clones[c].t_ns - state_.clones[c - 1].t_ns);
     slam_.diffuseBearings(dt_s);
     slam_.decayTrackErrors(dt_s);
+    decayImageShift(state_, dt_s);
     slam_.diffuseSceneDepth(dt_s);
   }
 

@@ -35,6 +35,7 @@ void FilterState::correct(const VecX& dx) {
     features[j].abr += dx.segment<3>(featureIndex(j));
     if (hasTrackErrors()) features[j].track_error += dx.segment<2>(featureIndex(j) + kFeatureDim);
   }
+  if (has_image_shift) image_shift += dx.segment<kImageShiftDim>(imageShiftIndex());
   if (has_scene_depth) scene_rho += dx(sceneDepthIndex());
 }
 
@@ -91,7 +92,7 @@ void FilterState::addFeature(const SlamFeature& f, const Mat3& P_ff,
                              const Eigen::Matrix<double, 3, Eigen::Dynamic>& P_fx) {
   require(P_fx.cols() == dim(), "FilterState::addFeature: cross-covariance has the wrong size");
   if (!hasTrackErrors()) {
-    insertRowsCols(P, featureIndex(features.size()), P_fx, P_ff);  // after the last feature, before ρ_s
+    insertRowsCols(P, featureIndex(features.size()), P_fx, P_ff);  // after the last feature, before s and ρ_s
     features.push_back(f);
     return;
   }
@@ -124,6 +125,17 @@ void FilterState::addSceneDepth(double rho, double variance) {
   scene_rho = rho;
 }
 
+void FilterState::addImageShift(const Mat2& cov, double time_s) {
+  require(!has_image_shift, "FilterState::addImageShift: the state has an image shift already");
+  require(cov.allFinite() && cov.determinant() > 0.0 && cov(0, 0) > 0.0 && time_s > 0.0,
+          "FilterState::addImageShift: the shift needs a positive-definite covariance and a positive time");
+  insertRowsCols(P, imageShiftIndex(), MatX::Zero(kImageShiftDim, dim()), cov);
+  has_image_shift = true;
+  image_shift.setZero();
+  image_shift_cov = cov;
+  image_shift_time_s = time_s;
+}
+
 VecX FilterState::yawDirection(const ImuState& x) const {
   // The rotation is about the vertical through the centroid c of the position
   // states (IMU and clones, first estimates), so that n is orthogonal to every
@@ -147,7 +159,8 @@ VecX FilterState::yawDirection(const ImuState& x) const {
 
 VecX FilterState::minus(const FilterState& ref) const {
   require(clones.size() == ref.clones.size() && features.size() == ref.features.size() &&
-              has_scene_depth == ref.has_scene_depth && feature_dim == ref.feature_dim,
+              has_scene_depth == ref.has_scene_depth && has_image_shift == ref.has_image_shift &&
+              feature_dim == ref.feature_dim,
           "FilterState::minus: states of different layouts");
   VecX d(dim());
   d.segment<3>(kIdxP) = imu.p_W_B - ref.imu.p_W_B;
@@ -165,6 +178,7 @@ VecX FilterState::minus(const FilterState& ref) const {
     if (hasTrackErrors())
       d.segment<2>(featureIndex(j) + kFeatureDim) = features[j].track_error - ref.features[j].track_error;
   }
+  if (has_image_shift) d.segment<kImageShiftDim>(imageShiftIndex()) = image_shift - ref.image_shift;
   if (has_scene_depth) d(sceneDepthIndex()) = scene_rho - ref.scene_rho;
   return d;
 }

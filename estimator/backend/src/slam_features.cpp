@@ -32,6 +32,10 @@ bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const 
     H->block<2, 2>(0, state.featureIndex(j) + kFeatureDim).setIdentity();
     *r -= f.track_error;
   }
+  if (state.has_image_shift && c + 1 == state.clones.size()) {  // z = π(h) + s + n, s the newest clone's
+    H->block<2, 2>(0, state.imageShiftIndex()).setIdentity();
+    *r -= state.image_shift;
+  }
   return true;
 }
 
@@ -72,6 +76,16 @@ void decayTrackErrors(FilterState& state, double dt_s, double time_s) {
   }
 }
 
+void decayImageShift(FilterState& state, double dt_s) {
+  if (!state.has_image_shift || !(dt_s > 0.0)) return;
+  const double phi = std::exp(-dt_s / state.image_shift_time_s);
+  const int k = state.imageShiftIndex();
+  state.image_shift *= phi;
+  state.P.middleRows(k, kImageShiftDim) *= phi;
+  state.P.middleCols(k, kImageShiftDim) *= phi;
+  state.P.block<2, 2>(k, k) += (1.0 - phi * phi) * state.image_shift_cov;
+}
+
 Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra) {
   const Mat2 W_inv = whiten.inverse();
   const Mat2 cov = sigma_z * sigma_z * W_inv * W_inv.transpose() + extra;
@@ -87,6 +101,26 @@ double correlatedSampleVarianceFactor(double dt_s, double time_s) {
   return 1.0 / std::tanh(0.5 * dt_s / time_s);
 }
 
+namespace {
+
+// A bearing taken from an observation of the newest clone, z = b + s + n,
+// is b̂ = z − ŝ and δb = −δs − n: the just-added feature's (α, β) (whose
+// δb = −n so far) and its mean move by the shift, P ← T P Tᵀ with T the
+// identity minus I₂ from the shift's columns into (α, β)'s rows.
+void bearingCarriesTheShift(FilterState& state, std::size_t c) {
+  if (!state.has_image_shift || c + 1 != state.clones.size()) return;
+  const std::size_t j = state.features.size() - 1;
+  const int a = state.featureIndex(j);
+  const int k = state.imageShiftIndex();
+  state.features[j].abr.head<2>() -= state.image_shift;
+  const MatX shift_rows = state.P.middleRows(k, kImageShiftDim);
+  state.P.middleRows(a, 2) -= shift_rows;
+  const MatX shift_cols = state.P.middleCols(k, kImageShiftDim);
+  state.P.middleCols(a, 2) -= shift_cols;
+}
+
+}  // namespace
+
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
                              double sigma_rho0, double sigma_z, const Mat2& whiten) {
   SlamFeature f;
@@ -99,6 +133,7 @@ void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, co
   P_ff.topLeftCorner<2, 2>() = sigma_z * sigma_z * W_inv * W_inv.transpose();
   P_ff(2, 2) = sigma_rho0 * sigma_rho0;
   state.addFeature(f, P_ff, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim()));
+  bearingCarriesTheShift(state, c);
 }
 
 void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t c, const Vec2& z,
@@ -117,6 +152,7 @@ void addSlamFeatureFromSceneDepth(FilterState& state, FeatureId id, std::size_t 
   Eigen::Matrix<double, 3, Eigen::Dynamic> P_fx = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, state.dim());
   P_fx.row(2) = state.P.row(s);
   state.addFeature(f, P_ff, P_fx);
+  bearingCarriesTheShift(state, c);
 }
 
 bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, const Vec3& abr, double sigma2,

@@ -40,6 +40,13 @@ struct GtTrackOptions {
   /// the track starts (0: none).
   double track_error_sigma_px = 0.0;
   double track_error_time_s = 0.5;
+  /// An error every point of one set shares (all tracks at once): a
+  /// first-order Gauss–Markov image shift s (px per axis), stationary σ
+  /// shared_error_sigma_px, correlation time shared_error_time_s, drawn from
+  /// its own stream ("gt_tracks_shared"), so the other draws stay as they
+  /// were (0: none).
+  double shared_error_sigma_px = 0.0;
+  double shared_error_time_s = 0.05;
 };
 
 /// Landmarks uniformly in the box [lo, hi].
@@ -103,6 +110,7 @@ class GroundTruthTracks {
         T_B_C_(T_B_C),
         options_(options),
         rng_(seed, "gt_tracks"),
+        shared_rng_(seed, "gt_tracks_shared"),
         tracked_(landmarks_.size(), false) {}
 
   /// The measurement set at t_ns for the exact body pose T_W_B.
@@ -110,6 +118,7 @@ class GroundTruthTracks {
     const Pose T_C_W = (T_W_B * T_B_C_).inverse();
     estimator::MeasurementSet set;
     set.t_ns = t_ns;
+    stepSharedError(t_ns);
     // Continue live tracks.
     for (auto it = live_.begin(); it != live_.end();) {
       Track& tr = *it;
@@ -120,7 +129,7 @@ class GroundTruthTracks {
         continue;
       }
       stepTrackError(tr, t_ns);
-      const Vec2 noisy = uv + noise() + tr.error;
+      const Vec2 noisy = uv + noise() + tr.error + shared_;
       set.features.push_back({tr.id, noisy, tr.last_uv, true});
       tr.last_uv = noisy;
       ++tr.length;
@@ -145,7 +154,7 @@ class GroundTruthTracks {
         if (options_.track_error_sigma_px > 0.0)  // no draw without it: the white-noise streams stay as they were
           tr.error = Vec2(rng_.normal(), rng_.normal()) * options_.track_error_sigma_px;
         tr.error_t_ns = t_ns;
-        tr.last_uv = uv + noise() + tr.error;
+        tr.last_uv = uv + noise() + tr.error + shared_;
         tr.length = 1;
         set.features.push_back({tr.id, tr.last_uv, tr.last_uv, false});
         tracked_[l] = true;
@@ -182,6 +191,21 @@ class GroundTruthTracks {
     tr.error_t_ns = t_ns;
   }
 
+  // The shared shift, the same exact step; drawn from its stationary law at the first set.
+  void stepSharedError(TimeNs t_ns) {
+    if (!(options_.shared_error_sigma_px > 0.0)) return;
+    const double sigma = options_.shared_error_sigma_px;
+    const Vec2 w(shared_rng_.normal(), shared_rng_.normal());
+    if (!shared_started_) {
+      shared_ = sigma * w;
+      shared_started_ = true;
+    } else {
+      const double phi = std::exp(-nsToSeconds(t_ns - shared_t_ns_) / options_.shared_error_time_s);
+      shared_ = phi * shared_ + std::sqrt(1.0 - phi * phi) * sigma * w;
+    }
+    shared_t_ns_ = t_ns;
+  }
+
   bool visible(const Vec3& p_C, Vec2* uv) const {
     return p_C.z() > options_.min_depth_m && camera_.project(p_C, uv) && camera_.isInside(*uv, options_.border_px);
   }
@@ -192,6 +216,10 @@ class GroundTruthTracks {
   Pose T_B_C_;
   GtTrackOptions options_;
   RandomStream rng_;
+  RandomStream shared_rng_;
+  Vec2 shared_ = Vec2::Zero();  ///< the shared shift, px
+  bool shared_started_ = false;
+  TimeNs shared_t_ns_ = 0;
   std::vector<bool> tracked_;
   std::vector<Track> live_;
   estimator::FeatureId next_id_ = 0;

@@ -7,7 +7,7 @@
 ///
 /// Error-state layout (the order of P's rows and columns):
 ///
-///   [ δp_W_B(3) δv_W(3) δθ_B(3) δb_g(3) δb_a(3) | clone 0 (δp_W_C, δθ_C) ... clone M-1 | f_0 (δα δβ δρ) ... f_N-1 | δρ_s ]
+///   [ δp_W_B(3) δv_W(3) δθ_B(3) δb_g(3) δb_a(3) | clone 0 (δp_W_C, δθ_C) ... clone M-1 | f_0 (δα δβ δρ) ... f_N-1 | δs(2) | δρ_s ]
 ///
 /// With track-error states (FilterState::feature_dim = 5,
 /// BackendOptions::slam_track_error_sigma_px > 0) each feature's block is
@@ -15,7 +15,10 @@
 /// error on this feature, a Gauss–Markov process (docs/algorithms.md "Track
 /// errors as states").
 ///
-/// with clones oldest first and features in insertion order; δρ_s, the
+/// with clones oldest first and features in insertion order; δs, the image
+/// shift every SLAM observation of the newest clone shares (normalised image
+/// units, BackendOptions::slam_image_shift_sigma_px, docs/algorithms.md "A
+/// shift the features share"), only once it has been added; δρ_s, the
 /// scene's inverse depth (1/m), only once it has been added
 /// (BackendOptions::slam_scene_depth_share, docs/algorithms.md "The scene's depth as a state").
 ///
@@ -75,6 +78,7 @@ inline constexpr int kImuDim = 15;
 inline constexpr int kCloneDim = 6;
 inline constexpr int kFeatureDim = 3;   ///< (α, β, ρ): a feature's block without track-error states
 inline constexpr int kTrackErrorDim = 2;  ///< (e_x, e_y) after (α, β, ρ) with them
+inline constexpr int kImageShiftDim = 2;  ///< (s_x, s_y), the shared image shift
 /// Offsets inside the IMU block.
 inline constexpr int kIdxP = 0, kIdxV = 3, kIdxTheta = 6, kIdxBg = 9, kIdxBa = 12;
 /// Offsets inside a clone block.
@@ -92,6 +96,15 @@ class FilterState {
   double scene_rho = 0.0;
   /// ρ_s has taken its one measurement from the triangulated points.
   bool scene_depth_measured = false;
+  /// The image shift s (normalised units) that every SLAM observation of the
+  /// newest clone shares, z = π(h) + s + n: a first-order Gauss–Markov
+  /// process with stationary covariance image_shift_cov and correlation time
+  /// image_shift_time_s (decayImageShift). Right after the features while
+  /// has_image_shift.
+  bool has_image_shift = false;
+  Vec2 image_shift = Vec2::Zero();
+  Mat2 image_shift_cov = Mat2::Zero();
+  double image_shift_time_s = 0.05;
   MatX P;                            ///< error-state covariance (dim × dim), symmetric PD
   /// Entries per feature: kFeatureDim, or kFeatureDim + kTrackErrorDim with
   /// track-error states. Set before the first feature is added.
@@ -104,11 +117,15 @@ class FilterState {
   double track_error_time_s = 0.5;
   bool hasTrackErrors() const { return feature_dim > kFeatureDim; }
 
-  /// Total error-state dimension 15 + 6 M + feature_dim N (+ 1 with the scene depth).
+  /// Total error-state dimension 15 + 6 M + feature_dim N (+ 2 with the image
+  /// shift, + 1 with the scene depth).
   int dim() const { return kImuDim + kCloneDim * static_cast<int>(clones.size()) +
-                           feature_dim * static_cast<int>(features.size()) + (has_scene_depth ? 1 : 0); }
+                           feature_dim * static_cast<int>(features.size()) + (has_image_shift ? kImageShiftDim : 0) +
+                           (has_scene_depth ? 1 : 0); }
+  /// First covariance index of s (requires has_image_shift).
+  int imageShiftIndex() const { return featureIndex(features.size()); }
   /// Covariance index of ρ_s (requires has_scene_depth).
-  int sceneDepthIndex() const { return featureIndex(features.size()); }
+  int sceneDepthIndex() const { return featureIndex(features.size()) + (has_image_shift ? kImageShiftDim : 0); }
   /// First covariance index of clone i (position in `clones`).
   int cloneIndex(std::size_t i) const { return kImuDim + kCloneDim * static_cast<int>(i); }
   /// First covariance index of feature j (position in `features`).
@@ -138,6 +155,9 @@ class FilterState {
   void removeFeature(std::size_t j);
   /// Adds ρ_s = rho with variance `variance`, uncorrelated with the rest.
   void addSceneDepth(double rho, double variance);
+  /// Adds the image shift s = 0 with its stationary covariance `cov` (normalised
+  /// units²), uncorrelated with the rest, after the features (before ρ_s).
+  void addImageShift(const Mat2& cov, double time_s);
 
   /// P ← (P + Pᵀ)/2.
   void symmetrize();
@@ -158,7 +178,7 @@ class FilterState {
 
   /// The error-state difference x ⊟ ref (the inverse of correct(): ref with
   /// correct(x ⊟ ref) gives x). Both states must have the same clones,
-  /// features and scene depth; rotations: Log(R_refᵀ R).
+  /// features, image shift and scene depth; rotations: Log(R_refᵀ R).
   VecX minus(const FilterState& ref) const;
 };
 

@@ -15,8 +15,11 @@ namespace evio::estimator {
 
 /// Residual r = z − π(h) of SLAM feature j observed at z in clone c (positions
 /// in state.features / state.clones) and its Jacobian H (2 × dim) over the
-/// anchor clone, the observing clone and the feature (visual_models.h).
-/// False when the feature is not in front of the clone.
+/// anchor clone, the observing clone and the feature (visual_models.h); with
+/// track-error states r = z − π(h) − e, and with the image shift, when c is
+/// the newest clone (the set being processed), r = z − π(h) − s (an older
+/// clone's observation shares an earlier shift the state no longer holds,
+/// which its noise carries). False when the feature is not in front of the clone.
 bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const Vec2& z,
                   Eigen::Matrix<double, 2, Eigen::Dynamic>* H, Vec2* r);
 
@@ -54,11 +57,19 @@ double correlatedSampleVarianceFactor(double dt_s, double time_s);
 /// No-op without track-error states or for dt ≤ 0.
 void decayTrackErrors(FilterState& state, double dt_s, double time_s);
 
+/// The image shift (filter_state.h, has_image_shift) over dt_s, the same
+/// exact Gauss–Markov step with its own time constant and covariance:
+///   s ← φ s,  P's s rows and columns × φ,  P_ss += (1 − φ²) Σ_s,  φ = exp(−dt/τ_s).
+/// No-op without the shift or for dt ≤ 0.
+void decayImageShift(FilterState& state, double dt_s);
+
 /// Depth-prior initialisation (Montiel et al. 2006; xVIO): anchor = clone c,
 /// (α, β) = z, ρ = rho0, with covariance diag(Σ_z, σ_ρ0²) (Σ_z = σ_z² W⁻¹W⁻ᵀ,
 /// W the observation's whitening, feature_track.h; σ_z² I when W = I) and zero
 /// cross-covariance — the parameters are relative to the anchor clone, whose
-/// own error is in the state, so the new feature is independent of it.
+/// own error is in the state, so the new feature is independent of it. With
+/// the image shift, when c is the newest clone, z = b + s + n gives
+/// (α, β) = z − ŝ and δ(α, β) = −δs − n (both functions).
 void addSlamFeatureWithPrior(FilterState& state, FeatureId id, std::size_t c, const Vec2& z, double rho0,
                              double sigma_rho0, double sigma_z, const Mat2& whiten = Mat2::Identity());
 

@@ -26,7 +26,16 @@ its age the time since the track's first point with a truth. Printed:
     itself);
   * the same for the error's change since the track's first kept point,
     e(t) − e(t0), which is what a filter that took the first point as the
-    feature's bearing sees.
+    feature's bearing sees;
+  * the integrated correlation time T = ∫ c(L) dL, by the trapezoid rule
+    over the given lags from c(0) = 1 up to the first lag where c turns
+    negative (there linearly to its zero): a run of samples Δt apart whose
+    errors correlate so carries about as much information about a slowly
+    changing quantity as one sample per 2T (for Δt ≪ T). With
+    --equivalent-at τ also the σ a filter that weighs the samples with an
+    exponential correlation of time constant τ (κ = coth(Δt/2τ) ≈ 2τ/Δt)
+    must state to take in the same information: σ_τ = σ sqrt(T/τ), σ the RMS
+    error per axis.
 
   * the tails: the share of points with |e| beyond 1, 2 and 3 px, and the
     runs of consecutive points of one track beyond --off-px (a track that
@@ -46,7 +55,13 @@ mean over the features m (px) and the spread s² of the features around it
 |m|²/2 (the per-axis variance of the all-feature mean), the same expected if
 the features' errors were independent (mean of s²/n), and their ratio. A
 ratio well above 1 is an error common to the features (a shared shift of
-the image) that averaging over features cannot remove.
+the image) that averaging over features cannot remove. With
+--common-lags k1,k2,... (bins) also the shared part's covariance k bins
+apart: the mean over bin pairs of m_b·m_{b+k}/2 less the features' own
+part, n_c C / (n_b n_{b+k}) with C = Σ_f d_f,b·d_f,b+k / (2 (n_c − 1))
+over the n_c features in both bins, d the feature's deviation from its
+bin's mean; and that over the shared variance at lag 0 (the difference of
+the first two figures above).
 
 With --lag-model the tracker's along-motion lag a + τ|v| is fitted and
 added back along v̂ at every point first (as track_noise_stats.py does, v the
@@ -57,7 +72,8 @@ lag").
 Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
        [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
        [--off-px 2] [--off-run 10] [--lag-model] [--min-speed 50]
-       [--common-bin 0.01] [--common-min-features 8]
+       [--common-bin 0.01] [--common-min-features 8] [--common-lags 1,2,5,10]
+       [--equivalent-at 0.042]
 """
 import argparse
 import os
@@ -145,20 +161,63 @@ def off_runs(errs, off_px):
     return np.array(runs, dtype=int)
 
 
-def common_mode(errs, bin_s, min_features):
-    """(bins used, median features per bin, mean |m|²/2, mean s²/n): the
-    per-axis variance of the bins' all-feature mean error and what it would
-    be with independent errors (see the module comment)."""
+def integrated_time(lags, corr):
+    """(T in s, whether c turned negative within the lags): the trapezoid
+    over (0, 1), (L_i, c_i) up to the first zero crossing."""
+    total, t0, c0 = 0.0, 0.0, 1.0
+    for t1, c1 in sorted(zip(lags, corr)):
+        if not np.isfinite(c1):
+            break
+        if c1 < 0.0:
+            t_zero = t0 + (t1 - t0) * c0 / (c0 - c1)
+            return total + 0.5 * c0 * (t_zero - t0), True
+        total += 0.5 * (c0 + c1) * (t1 - t0)
+        t0, c0 = t1, c1
+    return total, False
+
+
+def bin_means(errs, bin_s):
+    """{bin: {feature: its mean error in the bin (px, [2])}}."""
     per_bin = {}
-    for t, e, *_ in errs.values():
+    for fid, (t, e, *_) in errs.items():
         if len(t) == 0:
             continue
         bins = np.floor(t / bin_s).astype(np.int64)
         for b in np.unique(bins):
-            per_bin.setdefault(int(b), []).append(e[bins == b].mean(axis=0))
+            per_bin.setdefault(int(b), {})[fid] = e[bins == b].mean(axis=0)
+    return per_bin
+
+
+def shared_covariance(errs, bin_s, min_features, lag_bins):
+    """(pairs, covariance px² per axis) of the error the features share,
+    lag_bins bins apart (see the module comment)."""
+    per_bin = {b: f for b, f in bin_means(errs, bin_s).items() if len(f) >= min_features}
+    means = {b: np.mean(list(f.values()), axis=0) for b, f in per_bin.items()}
+    total, pairs = 0.0, 0
+    for b, feats in per_bin.items():
+        later = per_bin.get(b + lag_bins)
+        if later is None:
+            continue
+        both = feats.keys() & later.keys()
+        if len(both) == 1:
+            continue  # one feature in both bins: its own part cannot be told from the shared
+        # The features' own covariance, from their deviations from the bin
+        # means (divisor n_c − 1, as the spread's), enters the means' product
+        # n_c times over n_b n_{b+k} (none without a feature in both).
+        own = (sum(float(np.dot(feats[f] - means[b], later[f] - means[b + lag_bins])) for f in both) /
+               (len(both) - 1) if both else 0.0)
+        total += 0.5 * float(np.dot(means[b], means[b + lag_bins])) - 0.5 * own * len(both) / (len(feats) * len(later))
+        pairs += 1
+    return pairs, (total / pairs if pairs else float("nan"))
+
+
+def common_mode(errs, bin_s, min_features):
+    """(bins used, median features per bin, mean |m|²/2, mean s²/n): the
+    per-axis variance of the bins' all-feature mean error and what it would
+    be with independent errors (see the module comment)."""
     common, independent, sizes = [], [], []
-    for b in sorted(per_bin):
-        feature_means = np.array(per_bin[b])
+    for b, feats in sorted(bin_means(errs, bin_s).items()):
+        feature_means = np.array(list(feats.values()))
         n = len(feature_means)
         if n < min_features:
             continue
@@ -186,6 +245,9 @@ def main():
     ap.add_argument("--min-speed", type=float, default=50.0, help="px/s: the lag fit's points (as track_lag.py)")
     ap.add_argument("--common-bin", type=float, default=0.0, help="s: measure the error common to the features (0: off)")
     ap.add_argument("--common-min-features", type=int, default=8, help="bins with fewer features are left out")
+    ap.add_argument("--common-lags", default="", help="bins: the shared part's covariance this many bins apart")
+    ap.add_argument("--equivalent-at", type=float, default=0.0,
+                    help="s: the sigma an exponential weighting of this time constant must state (0: not printed)")
     a = ap.parse_args()
     if a.common_min_features < 2:
         sys.exit("track_error_stats: --common-min-features must be at least 2 (a spread needs two features)")
@@ -235,15 +297,29 @@ def main():
     print(f"runs beyond {a.off_px:g} px: {len(runs)}; {len(long_runs)} of at least {a.off_run} points, "
           f"holding {int(long_runs.sum())} points")
     print("lag (s)  corr e(t)   pairs    corr e(t)-e(t0)")
-    for lag in (float(x) for x in a.lags.split(",")):
+    lags, corr = [float(x) for x in a.lags.split(",")], []
+    for lag in lags:
         c, n = correlation(errs, lag, False)
         c0, _ = correlation(errs, lag, True)
+        corr.append(c)
         print(f"{lag:7.3f}  {c:9.3f}  {n:8d}  {c0:9.3f}")
+    T, crossed = integrated_time(lags, corr)
+    print(f"integrated correlation time {T * 1e3:.1f} ms " +
+          ("(to its first zero)" if crossed else f"(no zero within the lags, to {max(lags) * 1e3:g} ms)"))
+    if a.equivalent_at > 0:
+        sigma = np.sqrt(np.mean(e ** 2))
+        print(f"sigma to state with an exponential weighting of {a.equivalent_at * 1e3:g} ms: "
+              f"{sigma * np.sqrt(T / a.equivalent_at):.2f} px (RMS {sigma:.3f} px per axis)")
     if a.common_bin > 0:
         bins, features, common, independent = common_mode(errs, a.common_bin, a.common_min_features)
         print(f"common to the features, bins of {a.common_bin * 1e3:g} ms: {bins} bins, {features:g} features per bin; "
               f"all-feature mean {common:.4f} px² per axis, {independent:.4f} if independent, "
               f"ratio {common / independent:.2f}")
+        shared0 = common - independent
+        for k in (int(x) for x in a.common_lags.split(",") if x.strip()):
+            pairs, cov = shared_covariance(errs, a.common_bin, a.common_min_features, k)
+            print(f"shared part {k} bins ({k * a.common_bin * 1e3:g} ms) apart: {pairs} pairs, covariance "
+                  f"{cov:.4f} px² per axis, correlation {cov / shared0:.2f}")
 
 
 if __name__ == "__main__":

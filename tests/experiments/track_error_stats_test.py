@@ -3,8 +3,11 @@
 errors are known exactly: the shares of points beyond 1, 2 and 3 px and the
 runs of consecutive points of one track beyond --off-px, counted per track
 (a run never joins two tracks) with the points past --max-error left out;
-the along-motion lag a + τ|v| that --lag-model fits and removes; and the
-error common to the features at one time (--common-bin)."""
+the along-motion lag a + τ|v| that --lag-model fits and removes; the error
+common to the features at one time (--common-bin) and how long that shared
+part stays correlated (--common-lags); and the integrated correlation time
+with the σ an exponential weighting must state for it (--equivalent-at)."""
+import re
 import os
 import subprocess
 import sys
@@ -130,6 +133,89 @@ class TrackErrorCommonMode(unittest.TestCase):
             r = run(tracks, truth, "--common-bin", "0.01", "--common-min-features", "1")
             self.assertNotEqual(r.returncode, 0)
             self.assertIn("--common-min-features must be at least 2", r.stderr)
+
+
+class TrackErrorIntegratedTime(unittest.TestCase):
+    def test_constant_and_square_wave_errors(self):
+        # Constant errors (0.5, 0) px on three still tracks of 1 s: c(L) = 1 at
+        # every lag, so T is the last lag, 200 ms, with no zero; the RMS per
+        # axis is sqrt(0.25 / 2) = 0.354 px and at tau = 50 ms the sigma to
+        # state is 0.354 sqrt(200 / 50) = 0.71 px.
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            rows_t, rows_g = [], []
+            for fid in range(3):
+                for k in range(101):
+                    t = 0.01 * k
+                    rows_g.append((fid, t, 30.0 * fid, 40.0))
+                    rows_t.append((fid, t, 30.0 * fid + 0.5, 40.0))
+            write(tracks, rows_t)
+            write(truth, rows_g)
+            r = subprocess.run([sys.executable, SCRIPT, tracks, truth, "--lags", "0.01,0.1,0.2",
+                                "--equivalent-at", "0.05"], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("integrated correlation time 200.0 ms (no zero within the lags, to 200 ms)", r.stdout)
+            self.assertIn("sigma to state with an exponential weighting of 50 ms: 0.71 px (RMS 0.354 px per axis)",
+                          r.stdout)
+        # A square wave of period 0.2 s (±0.5 px, points 1 ms apart): c(L) =
+        # 1 − 4L/0.2 up to L = 0.1 s, zero at 50 ms, so T is the triangle's
+        # area, 25 ms (within 1 ms: the stamps are written to 1 ms).
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            rows_t, rows_g = [], []
+            for k in range(2001):
+                t = 0.001 * k + 0.0005
+                sign = 1.0 if int(t / 0.1) % 2 == 0 else -1.0
+                rows_g.append((0, t, 60.0, 40.0))
+                rows_t.append((0, t, 60.0 + 0.5 * sign, 40.0))
+            write(tracks, rows_t)
+            write(truth, rows_g)
+            r = subprocess.run([sys.executable, SCRIPT, tracks, truth, "--lags", "0.01,0.02,0.04,0.06,0.1"],
+                               capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            m = re.search(r"integrated correlation time ([0-9.]+) ms \(to its first zero\)", r.stdout)
+            self.assertIsNotNone(m, r.stdout)
+            self.assertAlmostEqual(float(m.group(1)), 25.0, delta=1.0)
+
+
+class TrackErrorSharedCorrelation(unittest.TestCase):
+    def test_the_shared_part_is_told_from_the_features_own(self):
+        # Ten still features, one point per 10 ms bin for 30 s. Each point's
+        # error is a shift shared by all (first-order, per axis σ 0.2 px,
+        # correlation 0.6 from bin to bin) plus the feature's own (σ 1 px,
+        # 0.9 from bin to bin). The shared part's variance is 0.04 px² and
+        # its correlation 0.6 one bin apart and 0.36 two apart. Without
+        # removing the features' own part the bin means would correlate at
+        # (0.6 · 0.04 + 0.9 · 0.1) / 0.14 = 0.81 one bin apart.
+        import numpy as np
+        rng = np.random.default_rng(5)
+        n_bins, n_feat = 3000, 10
+        shared = np.zeros((n_bins, 2))
+        own = np.zeros((n_bins, n_feat, 2))
+        shared[0] = rng.normal(0, 0.2, 2)
+        own[0] = rng.normal(0, 1.0, (n_feat, 2))
+        for b in range(1, n_bins):
+            shared[b] = 0.6 * shared[b - 1] + np.sqrt(1 - 0.36) * rng.normal(0, 0.2, 2)
+            own[b] = 0.9 * own[b - 1] + np.sqrt(1 - 0.81) * rng.normal(0, 1.0, (n_feat, 2))
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            with open(tracks, "w") as ft, open(truth, "w") as fg:
+                for f in range(n_feat):
+                    for b in range(n_bins):
+                        t = 0.01 * b + 0.005
+                        e = shared[b] + own[b, f]
+                        fg.write(f"{f} {t:.3f} {20.0 * f} 50.0\n")
+                        ft.write(f"{f} {t:.3f} {20.0 * f + e[0]:.6f} {50.0 + e[1]:.6f}\n")
+            r = subprocess.run([sys.executable, SCRIPT, tracks, truth, "--lags", "0.01", "--max-error", "100",
+                                "--common-bin", "0.01", "--common-lags", "1,2"], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            m = re.search(r"all-feature mean ([0-9.]+) px² per axis, ([0-9.]+) if independent", r.stdout)
+            self.assertIsNotNone(m, r.stdout)
+            self.assertAlmostEqual(float(m.group(1)) - float(m.group(2)), 0.04, delta=0.008)
+            corr = {int(k): float(c) for k, c in
+                    re.findall(r"shared part (\d+) bins .* correlation (-?[0-9.]+)", r.stdout)}
+            self.assertAlmostEqual(corr[1], 0.6, delta=0.1)
+            self.assertAlmostEqual(corr[2], 0.36, delta=0.1)
 
 
 if __name__ == "__main__":

@@ -11,11 +11,13 @@
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/visual_models.h"
+#include "numeric_state_jacobian.h"
 #include "random_state.h"
 
 namespace evio::estimator {
 namespace {
 
+using test::numericStateJacobian;
 using test::randomSpdCovariance;
 using test::randomVec3;
 
@@ -107,20 +109,15 @@ TEST(ImageShiftState, SlamResidualJacobianCoversTheShiftInTheNewestCloneOnly) {
       Eigen::Matrix<double, 2, Eigen::Dynamic> H;
       Vec2 r;
       ASSERT_TRUE(slamResidual(s, j, c, z, &H, &r));
-      MatX num(2, s.dim());
-      const double h = 1e-6;
-      for (int k = 0; k < s.dim(); ++k) {
-        FilterState sp = s, sm = s;
-        VecX d = VecX::Zero(s.dim());
-        d(k) = h;
-        sp.correct(d);
-        sm.correct(-d);
-        Eigen::Matrix<double, 2, Eigen::Dynamic> Hp, Hm;
-        Vec2 rp, rm;
-        ASSERT_TRUE(slamResidual(sp, j, c, z, &Hp, &rp));
-        ASSERT_TRUE(slamResidual(sm, j, c, z, &Hm, &rm));
-        num.col(k) = -(rp - rm) / (2.0 * h);
-      }
+      const MatX num = numericStateJacobian(
+          s,
+          [&](const FilterState& x) {
+            Eigen::Matrix<double, 2, Eigen::Dynamic> Hx;
+            Vec2 rx;
+            EXPECT_TRUE(slamResidual(x, j, c, z, &Hx, &rx));
+            return VecX(-rx);
+          },
+          2);
       EXPECT_LT((MatX(H) - num).norm(), 1e-7) << "clone " << c << " feature " << j;
       const MatX H_s = H.block(0, s.imageShiftIndex(), 2, 2);
       if (c == 2)

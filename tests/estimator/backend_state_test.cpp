@@ -16,10 +16,12 @@
 #include "evio/estimator/backend/slam_features.h"
 #include "evio/estimator/backend/visual_models.h"
 #include "numeric_jacobian.h"
+#include "numeric_state_jacobian.h"
 
 namespace evio::estimator {
 namespace {
 
+using test::numericStateJacobian;
 using test::randomSpdCovariance;
 using test::randomVec3;
 
@@ -51,21 +53,6 @@ FilterState makeState(std::uint64_t seed) {
   }
   s.P = randomSpdCovariance(s.dim(), 1e-3, rng);
   return s;
-}
-
-// J(:, k) = (f(x ⊞ h e_k) − f(x ⊞ −h e_k)) / 2h over the full error state.
-template <class F>
-MatX numericStateJacobian(const FilterState& s, F&& f, int rows, double h = 1e-6) {
-  MatX J(rows, s.dim());
-  for (int k = 0; k < s.dim(); ++k) {
-    FilterState sp = s, sm = s;
-    VecX d = VecX::Zero(s.dim());
-    d(k) = h;
-    sp.correct(d);
-    sm.correct(-d);
-    J.col(k) = (f(sp) - f(sm)) / (2.0 * h);
-  }
-  return J;
 }
 
 TEST(BackendStateJacobians, SlamResidualOverTheWholeState) {

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "evio/core/random_stream.h"
+#include "numeric_state_jacobian.h"
 #include "random_state.h"
 #include "evio/core/so3.h"
 #include "evio/estimator/backend/msckf_update.h"
@@ -18,6 +19,7 @@
 namespace evio::estimator {
 namespace {
 
+using test::numericStateJacobian;
 using test::randomSpdCovariance;
 using test::randomVec3;
 
@@ -68,20 +70,15 @@ TEST(TrackErrorStates, SlamResidualJacobianCoversTheTrackError) {
     Vec2 r;
     ASSERT_TRUE(slamResidual(s, j, 2, z, &H, &r));
     // r = z − π(h) − e: H = −∂r/∂δx by central differences over correct().
-    MatX num(2, s.dim());
-    const double h = 1e-6;
-    for (int k = 0; k < s.dim(); ++k) {
-      FilterState sp = s, sm = s;
-      VecX d = VecX::Zero(s.dim());
-      d(k) = h;
-      sp.correct(d);
-      sm.correct(-d);
-      Eigen::Matrix<double, 2, Eigen::Dynamic> Hp, Hm;
-      Vec2 rp, rm;
-      ASSERT_TRUE(slamResidual(sp, j, 2, z, &Hp, &rp));
-      ASSERT_TRUE(slamResidual(sm, j, 2, z, &Hm, &rm));
-      num.col(k) = -(rp - rm) / (2.0 * h);
-    }
+    const MatX num = numericStateJacobian(
+        s,
+        [&](const FilterState& x) {
+          Eigen::Matrix<double, 2, Eigen::Dynamic> Hx;
+          Vec2 rx;
+          EXPECT_TRUE(slamResidual(x, j, 2, z, &Hx, &rx));
+          return VecX(-rx);
+        },
+        2);
     EXPECT_LT((MatX(H) - num).norm(), 1e-7) << "feature " << j;
     // The track error enters with the identity, and only the feature's own.
     const int e = s.featureIndex(j) + kFeatureDim;

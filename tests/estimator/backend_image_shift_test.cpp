@@ -8,9 +8,8 @@
 
 #include "evio/core/error.h"
 #include "evio/core/random_stream.h"
-#include "evio/core/so3.h"
 #include "evio/estimator/backend/slam_features.h"
-#include "evio/estimator/backend/visual_models.h"
+#include "down_looking_state.h"
 #include "numeric_state_jacobian.h"
 #include "random_state.h"
 
@@ -19,7 +18,6 @@ namespace {
 
 using test::numericStateJacobian;
 using test::randomSpdCovariance;
-using test::randomVec3;
 
 const Mat2 kShiftCov = Vec2(4e-6, 9e-6).asDiagonal();  // normalised units²
 constexpr double kShiftTime_s = 0.05;
@@ -30,27 +28,9 @@ constexpr double kShiftTime_s = 0.05;
 FilterState makeStateWithShift(std::uint64_t seed) {
   RandomStream rng(seed, "image_shift_state");
   FilterState s;
-  s.imu.p_W_B = Vec3(0.0, 0.0, 10.0);
-  s.imu.q_W_B = so3::expQuat(randomVec3(rng, 0.1));
-  const Mat3 R_down = Vec3(1.0, -1.0, -1.0).asDiagonal();
-  for (int i = 0; i < 3; ++i) {
-    CameraClone c;
-    c.id = 10 + i;
-    c.t_ns = secondsToNs(0.01 * i);
-    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randomVec3(rng, 0.05);
-    c.q_W_C = Quat(R_down * so3::exp(randomVec3(rng, 0.05)));
-    s.clones.push_back(c);
-  }
-  s.P = MatX::Identity(s.dim(), s.dim()) * 1e-3;
+  test::addDownLookingClones(s, rng);
   s.addImageShift(kShiftCov, kShiftTime_s);
-  const Vec3 ground[2] = {Vec3(1.0, 1.0, 0.3), Vec3(-1.5, 0.5, -0.2)};
-  for (int j = 0; j < 2; ++j) {
-    SlamFeature f;
-    f.id = 100 + j;
-    f.anchor_clone_id = 10 + j;
-    EXPECT_TRUE(worldToAnchored(s.clones[static_cast<std::size_t>(j)], ground[j], &f.abr));
-    s.addFeature(f, Mat3::Identity() * 1e-4, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, s.dim()));
-  }
+  EXPECT_TRUE(test::addTwoGroundFeatures(s));
   s.image_shift = Vec2(rng.normal(), rng.normal()) * 0.002;
   s.P = randomSpdCovariance(s.dim(), 1e-3, rng);
   return s;

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "evio/core/random_stream.h"
+#include "down_looking_state.h"
 #include "numeric_state_jacobian.h"
 #include "random_state.h"
 #include "evio/core/so3.h"
@@ -21,7 +22,6 @@ namespace {
 
 using test::numericStateJacobian;
 using test::randomSpdCovariance;
-using test::randomVec3;
 
 // Three clones looking down from 10 m, two features added through
 // addFeature (so with their track-error blocks), track errors nonzero, and
@@ -31,25 +31,8 @@ FilterState makeStateWithTrackErrors(std::uint64_t seed) {
   FilterState s;
   s.feature_dim = kFeatureDim + kTrackErrorDim;
   s.track_error_cov = Vec2(4e-5, 9e-5).asDiagonal();
-  s.imu.p_W_B = Vec3(0.0, 0.0, 10.0);
-  s.imu.q_W_B = so3::expQuat(randomVec3(rng, 0.1));
-  const Mat3 R_down = Vec3(1.0, -1.0, -1.0).asDiagonal();
-  for (int i = 0; i < 3; ++i) {
-    CameraClone c;
-    c.id = 10 + i;
-    c.p_W_C = Vec3(0.3 * i, 0.1 * i, 10.0) + randomVec3(rng, 0.05);
-    c.q_W_C = Quat(R_down * so3::exp(randomVec3(rng, 0.05)));
-    s.clones.push_back(c);
-  }
-  s.P = MatX::Identity(s.dim(), s.dim()) * 1e-3;
-  const Vec3 ground[2] = {Vec3(1.0, 1.0, 0.3), Vec3(-1.5, 0.5, -0.2)};
-  for (int j = 0; j < 2; ++j) {
-    SlamFeature f;
-    f.id = 100 + j;
-    f.anchor_clone_id = 10 + j;
-    EXPECT_TRUE(worldToAnchored(s.clones[static_cast<std::size_t>(j)], ground[j], &f.abr));
-    s.addFeature(f, Mat3::Identity() * 1e-4, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, s.dim()));
-  }
+  test::addDownLookingClones(s, rng);
+  EXPECT_TRUE(test::addTwoGroundFeatures(s));
   for (SlamFeature& f : s.features) f.track_error = Vec2(rng.normal(), rng.normal()) * 0.005;
   s.P = randomSpdCovariance(s.dim(), 1e-3, rng);
   return s;

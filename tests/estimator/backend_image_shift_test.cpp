@@ -142,6 +142,30 @@ TEST(ImageShiftState, NewFeatureBearingCarriesMinusTheShift) {
   EXPECT_EQ(MatX(older.P.block(b, 0, 2, b)).norm(), 0.0);
 }
 
+// The whitened rows of an observation (MSCKF, triangulated initialisation)
+// gain W on s and lose W ŝ from the residual in the newest clone only.
+TEST(ImageShiftState, WhitenedRowsOfTheNewestCloneCarryTheShift) {
+  const FilterState s = makeStateWithShift(7);
+  const Mat2 W = (Mat2() << 2.0, 0.5, 0.0, 1.5).finished();
+  const MatX H0 = MatX::Constant(4, s.dim(), 0.1);
+  const VecX r0 = VecX::Constant(4, 0.2);
+  MatX H = H0;
+  VecX r = r0;
+  addImageShiftToRows(s, 2, W, 2, &H, &r);  // rows 2-3, the newest clone
+  const int k = s.imageShiftIndex();
+  EXPECT_TRUE((MatX(H.block(2, k, 2, 2)) - (MatX::Constant(2, 2, 0.1) + MatX(W))).norm() < 1e-15);
+  EXPECT_LT((VecX(r.segment<2>(2)) - (Vec2(0.2, 0.2) - W * s.image_shift)).norm(), 1e-15);
+  MatX H_rest = H;
+  H_rest.block(2, k, 2, 2) = H0.block(2, k, 2, 2);
+  EXPECT_EQ(H_rest, H0);  // nothing else moves
+  EXPECT_EQ(VecX(r.head<2>()), VecX(r0.head<2>()));
+  MatX H_old = H0;
+  VecX r_old = r0;
+  addImageShiftToRows(s, 1, W, 2, &H_old, &r_old);  // an older clone: nothing
+  EXPECT_EQ(H_old, H0);
+  EXPECT_EQ(r_old, r0);
+}
+
 // Two steps of dt1 and dt2 are one step of dt1 + dt2, the mean decays by
 // exp(−dt/τ), the stationary covariance stays stationary and nothing else moves.
 TEST(ImageShiftState, GaussMarkovStepIsExactOverAnyInterval) {

@@ -62,6 +62,13 @@ void insertRowsCols(MatX& P, int index, const MatX& C, const MatX& B) {
 
 }  // namespace
 
+void addImageShiftToRows(const FilterState& state, std::size_t c, const Mat2& W, Eigen::Index row, MatX* H,
+                         VecX* r) {
+  if (!state.has_image_shift || !state.isNewestClone(c)) return;
+  H->block<2, kImageShiftDim>(row, state.imageShiftIndex()) += W;
+  r->segment<2>(row) -= W * state.image_shift;
+}
+
 void removeRowsCols(MatX& P, int index, int size) {
   const int n = static_cast<int>(P.rows());
   const int tail = n - index - size;

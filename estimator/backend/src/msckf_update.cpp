@@ -101,6 +101,7 @@ MsckfOutcome msckfResidual(const FilterState& state, const FeatureTrack& track, 
     r.segment<2>(row) = W[i] * (z[i] - zh);
     H_x.block<2, 6>(row, state.cloneIndex(pos[i])) = W[i] * Hc;
     H_f.block<2, 3>(row, 0) = W[i] * Hp;
+    addImageShiftToRows(state, pos[i], W[i], row, &H_x, &r);
   }
   if (m <= 3) return MsckfOutcome::kTooShort;
   if (!projectTrackRows(state, clones, W, sigma2_z, &H_x, &H_f, &r)) return MsckfOutcome::kProjectionFailed;
@@ -171,6 +172,7 @@ MsckfOutcome rotationResidual(const FilterState& state, const FeatureTrack& trac
     H_x.block<2, 6>(row, state.cloneIndex(pos[i])) += W[i] * Hc;
     H_x.block<2, 6>(row, anchor_col) += W[i] * Ha;
     H_f.block<2, 3>(row, 0) = W[i] * Hf;
+    addImageShiftToRows(state, pos[i], W[i], row, &H_x, &r);
   }
   if (!projectTrackRows(state, clones, W, sigma2_z, &H_x, &H_f, &r)) return MsckfOutcome::kProjectionFailed;
   out->H = std::move(H_x);

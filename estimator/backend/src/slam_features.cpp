@@ -32,7 +32,7 @@ bool slamResidual(const FilterState& state, std::size_t j, std::size_t c, const 
     H->block<2, 2>(0, state.featureIndex(j) + kFeatureDim).setIdentity();
     *r -= f.track_error;
   }
-  if (state.has_image_shift && c + 1 == state.clones.size()) {  // z = π(h) + s + n, s the newest clone's
+  if (state.has_image_shift && state.isNewestClone(c)) {  // z = π(h) + s + n, s the newest clone's
     H->block<2, 2>(0, state.imageShiftIndex()).setIdentity();
     *r -= state.image_shift;
   }
@@ -108,7 +108,7 @@ namespace {
 // δb = −n so far) and its mean move by the shift, P ← T P Tᵀ with T the
 // identity minus I₂ from the shift's columns into (α, β)'s rows.
 void bearingCarriesTheShift(FilterState& state, std::size_t c) {
-  if (!state.has_image_shift || c + 1 != state.clones.size()) return;
+  if (!state.has_image_shift || !state.isNewestClone(c)) return;
   const std::size_t j = state.features.size() - 1;
   const int a = state.featureIndex(j);
   const int k = state.imageShiftIndex();
@@ -184,6 +184,7 @@ bool splitTriangulatedInit(const FilterState& state, const FeatureTrack& track, 
     r.segment<2>(row) = obs[i]->whiten * (obs[i]->z - zh);  // whitened to σ_z² I (feature_track.h)
     H_x.middleRows<2>(row) = obs[i]->whiten * H_x.middleRows<2>(row);
     H_f.middleRows<2>(row) = obs[i]->whiten * H_f.middleRows<2>(row);
+    addImageShiftToRows(state, c, obs[i]->whiten, row, &H_x, &r);
   }
   if (prior != nullptr) {
     // The prior as one more row, ρ0 = ρ + w with w ~ N(0, σ_ρ0²), whitened to σ_z²; no pose in it.

@@ -96,11 +96,11 @@ class FilterState {
   double scene_rho = 0.0;
   /// ρ_s has taken its one measurement from the triangulated points.
   bool scene_depth_measured = false;
-  /// The image shift s (normalised units) that every SLAM observation of the
+  /// The image shift s (normalised units) that every observation of the
   /// newest clone shares, z = π(h) + s + n: a first-order Gauss–Markov
   /// process with stationary covariance image_shift_cov and correlation time
-  /// image_shift_time_s (decayImageShift). Right after the features while
-  /// has_image_shift.
+  /// image_shift_time_s (decayImageShift). When present (has_image_shift),
+  /// its two entries follow the last feature's.
   bool has_image_shift = false;
   Vec2 image_shift = Vec2::Zero();
   Mat2 image_shift_cov = Mat2::Zero();
@@ -132,6 +132,8 @@ class FilterState {
   int featureIndex(std::size_t j) const {
     return kImuDim + kCloneDim * static_cast<int>(clones.size()) + feature_dim * static_cast<int>(j);
   }
+  /// Whether clone c (position in `clones`) is the newest: the set being processed.
+  bool isNewestClone(std::size_t c) const { return c + 1 == clones.size(); }
   /// Position of the clone with `id` in `clones`, or -1.
   int findClone(std::int64_t id) const;
   /// Position of the feature with `id` in `features`, or -1.
@@ -181,6 +183,13 @@ class FilterState {
   /// features, image shift and scene depth; rotations: Log(R_refᵀ R).
   VecX minus(const FilterState& ref) const;
 };
+
+/// With the image shift, an observation of the newest clone is
+/// z = π(h) + s + n: its whitened rows at `row` (whitening W, 2 rows of H, r)
+/// gain W on s's columns, and its whitened residual loses W ŝ. Nothing for
+/// an older clone's observation (it saw an earlier shift, which the state no
+/// longer holds and its noise carries) or without the shift.
+void addImageShiftToRows(const FilterState& state, std::size_t c, const Mat2& W, Eigen::Index row, MatX* H, VecX* r);
 
 /// Removes `size` rows and columns starting at `index` from a square matrix.
 void removeRowsCols(MatX& P, int index, int size);

@@ -162,18 +162,19 @@ def off_runs(errs, off_px):
 
 
 def integrated_time(lags, corr):
-    """(T in s, whether c turned negative within the lags): the trapezoid
-    over (0, 1), (L_i, c_i) up to the first zero crossing."""
+    """(T in s, how it ended: "zero", "lags" or "no pairs"): the trapezoid
+    over (0, 1), (L_i, c_i) up to the first zero crossing, the last lag, or
+    the first lag without pairs, whichever comes first."""
     total, t0, c0 = 0.0, 0.0, 1.0
     for t1, c1 in sorted(zip(lags, corr)):
         if not np.isfinite(c1):
-            break
+            return total, "no pairs"
         if c1 < 0.0:
             t_zero = t0 + (t1 - t0) * c0 / (c0 - c1)
-            return total + 0.5 * c0 * (t_zero - t0), True
+            return total + 0.5 * c0 * (t_zero - t0), "zero"
         total += 0.5 * (c0 + c1) * (t1 - t0)
         t0, c0 = t1, c1
-    return total, False
+    return total, "lags"
 
 
 def bin_means(errs, bin_s):
@@ -204,9 +205,11 @@ def shared_covariance(errs, bin_s, min_features, lag_bins):
         # The features' own covariance, from their deviations from the bin
         # means (divisor n_c − 1, as the spread's), enters the means' product
         # n_c times over n_b n_{b+k} (none without a feature in both).
-        own = (sum(float(np.dot(feats[f] - means[b], later[f] - means[b + lag_bins])) for f in both) /
-               (len(both) - 1) if both else 0.0)
-        total += 0.5 * float(np.dot(means[b], means[b + lag_bins])) - 0.5 * own * len(both) / (len(feats) * len(later))
+        own = 0.0
+        if both:
+            products = [float(np.dot(feats[f] - means[b], later[f] - means[b + lag_bins])) for f in both]
+            own = sum(products) / (len(both) - 1) * len(both) / (len(feats) * len(later))
+        total += 0.5 * float(np.dot(means[b], means[b + lag_bins])) - 0.5 * own
         pairs += 1
     return pairs, (total / pairs if pairs else float("nan"))
 
@@ -249,6 +252,8 @@ def main():
     ap.add_argument("--equivalent-at", type=float, default=0.0,
                     help="s: the sigma an exponential weighting of this time constant must state (0: not printed)")
     a = ap.parse_args()
+    if a.common_lags.strip() and not a.common_bin > 0:
+        sys.exit("track_error_stats: --common-lags needs --common-bin")
     if a.common_min_features < 2:
         sys.exit("track_error_stats: --common-min-features must be at least 2 (a spread needs two features)")
     errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
@@ -303,9 +308,10 @@ def main():
         c0, _ = correlation(errs, lag, True)
         corr.append(c)
         print(f"{lag:7.3f}  {c:9.3f}  {n:8d}  {c0:9.3f}")
-    T, crossed = integrated_time(lags, corr)
+    T, end = integrated_time(lags, corr)
     print(f"integrated correlation time {T * 1e3:.1f} ms " +
-          ("(to its first zero)" if crossed else f"(no zero within the lags, to {max(lags) * 1e3:g} ms)"))
+          {"zero": "(to its first zero)", "lags": f"(no zero within the lags, to {max(lags) * 1e3:g} ms)",
+           "no pairs": "(to the last lag with pairs)"}[end])
     if a.equivalent_at > 0:
         sigma = np.sqrt(np.mean(e ** 2))
         print(f"sigma to state with an exponential weighting of {a.equivalent_at * 1e3:g} ms: "
@@ -318,8 +324,9 @@ def main():
         shared0 = common - independent
         for k in (int(x) for x in a.common_lags.split(",") if x.strip()):
             pairs, cov = shared_covariance(errs, a.common_bin, a.common_min_features, k)
+            corr_text = f"correlation {cov / shared0:.2f}" if shared0 > 0 else "no shared variance at lag 0"
             print(f"shared part {k} bins ({k * a.common_bin * 1e3:g} ms) apart: {pairs} pairs, covariance "
-                  f"{cov:.4f} px² per axis, correlation {cov / shared0:.2f}")
+                  f"{cov:.4f} px² per axis, {corr_text}")
 
 
 if __name__ == "__main__":

@@ -133,6 +133,10 @@ class TrackErrorCommonMode(unittest.TestCase):
             r = run(tracks, truth, "--common-bin", "0.01", "--common-min-features", "1")
             self.assertNotEqual(r.returncode, 0)
             self.assertIn("--common-min-features must be at least 2", r.stderr)
+            # Lags of bins without bins: refused too.
+            r = run(tracks, truth, "--common-lags", "1")
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--common-lags needs --common-bin", r.stderr)
 
 
 class TrackErrorIntegratedTime(unittest.TestCase):

@@ -143,7 +143,7 @@ SlamInitOutcome addSlamFeatureTriangulated(FilterState& state, const FeatureTrac
     return SlamInitOutcome::kDegenerate;
   if (r2.size() > 0 && slamMahalanobis(state, H2, r2, sigma2) > chi2_threshold(static_cast<int>(r2.size())))
     return SlamInitOutcome::kGateFailed;
-  const int k = state.featureIndex(state.features.size());  // where the feature goes (before ρ_s)
+  const int k = state.featureIndex(state.features.size());  // where the feature goes (before s and ρ_s)
   state.addFeature(f, P_ff, P_fx);
   if (r2.size() == 0) return SlamInitOutcome::kOk;
   MatX H2_new = MatX::Zero(H2.rows(), state.dim());  // the new feature's columns are zero

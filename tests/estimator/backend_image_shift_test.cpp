@@ -126,6 +126,7 @@ TEST(ImageShiftState, NewFeatureBearingCarriesMinusTheShift) {
   const double sigma_z = 0.004, sigma_rho0 = 0.5;
   addSlamFeatureWithPrior(s, 400, 2, z, 1.0, sigma_rho0, sigma_z);
   ASSERT_EQ(s.dim(), before.dim() + kFeatureDim);
+  // The new feature takes the shift's old place (a == k0) and the shift moves behind it.
   const int a = s.featureIndex(2), k = s.imageShiftIndex(), k0 = before.imageShiftIndex();
   EXPECT_LT((s.features[2].abr.head<2>() - (z - before.image_shift)).norm(), 1e-15);
   const Mat2 P_ss = before.P.block<2, 2>(k0, k0);

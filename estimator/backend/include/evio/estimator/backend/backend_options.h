@@ -147,8 +147,8 @@ struct BackendOptions {
   double slam_track_error_sigma_px = 0.0;
   double slam_track_error_time_s = 0.5;
   /// A shift the features share (docs/algorithms.md "A shift the features
-  /// share"): an error common to every SLAM observation of one measurement
-  /// set, z = π(h) + s + n, which averaging over features does not reduce,
+  /// share"): an error common to every observation of one measurement set
+  /// (the newest clone), z = π(h) + s + n, which averaging over features does not reduce,
   /// as a 2-vector state s (normalised units), a first-order Gauss–Markov
   /// process with stationary σ (px per axis) and correlation time. 0: off.
   double slam_image_shift_sigma_px = 0.0;
@@ -345,7 +345,7 @@ struct BackendOptions {
       "track errors as states: stationary sigma of a SLAM feature's track error, px (0: off)");
     v("slam_track_error_time_s", slam_track_error_time_s, "track errors as states: correlation time, s");
     v("slam_image_shift_sigma_px", slam_image_shift_sigma_px,
-      "an image shift every SLAM observation of a set shares, as a state: stationary sigma per axis, px (0: off)");
+      "an image shift every observation of a set shares, as a state: stationary sigma per axis, px (0: off)");
     v("slam_image_shift_time_s", slam_image_shift_time_s, "that shift's correlation time, s");
     v("msckf_use_lost_tracks", msckf_use_lost_tracks, "use tracks lost before spanning the window");
     v("msckf_min_track_length", msckf_min_track_length, "minimum MSCKF track length");

@@ -16,7 +16,7 @@
 /// errors as states").
 ///
 /// with clones oldest first and features in insertion order; δs, the image
-/// shift every SLAM observation of the newest clone shares (normalised image
+/// shift every observation of the newest clone shares (normalised image
 /// units, BackendOptions::slam_image_shift_sigma_px, docs/algorithms.md "A
 /// shift the features share"), only once it has been added; δρ_s, the
 /// scene's inverse depth (1/m), only once it has been added

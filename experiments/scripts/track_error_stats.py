@@ -234,7 +234,7 @@ def common_mode(errs, bin_s, min_features):
     return len(common), float(np.median(sizes)), float(np.mean(common)), float(np.mean(independent))
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("tracks")
     ap.add_argument("truth")
@@ -256,28 +256,25 @@ def main():
         sys.exit("track_error_stats: --common-lags needs --common-bin")
     if a.common_min_features < 2:
         sys.exit("track_error_stats: --common-min-features must be at least 2 (a spread needs two features)")
-    errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
-    if not errs:
-        sys.exit("no track has a truth")
-    n_all = sum(len(v[0]) for v in errs.values())
-    for fid, (t, e, age, v) in list(errs.items()):
-        keep = np.linalg.norm(e, axis=1) <= a.max_error
-        errs[fid] = (t[keep], e[keep], age[keep], v[keep])
-    if a.lag_model:
-        ids = list(errs)
-        sizes = [len(errs[fid][0]) for fid in ids]
-        e_all, lag_a, lag_tau = remove_lag(np.concatenate([errs[fid][1] for fid in ids]),
-                                           np.concatenate([errs[fid][3] for fid in ids]), a.min_speed)
-        for fid, part in zip(ids, np.split(e_all, np.cumsum(sizes)[:-1])):
-            t, _, age, v = errs[fid]
-            errs[fid] = (t, part, age, v)
-        print(f"lag removed: a = {lag_a:.3f} px, tau = {lag_tau * 1e3:.2f} ms")
-    e = np.concatenate([v[1] for v in errs.values()])
-    age = np.concatenate([v[2] for v in errs.values()])
-    print(f"tracks {len(errs)}  points {n_all}, {len(e)} with |e| <= {a.max_error} px")
-    print(f"RMS error x {np.sqrt(np.mean(e[:, 0] ** 2)):.3f} px  y {np.sqrt(np.mean(e[:, 1] ** 2)):.3f} px  "
-          f"median |e| {np.median(np.linalg.norm(e, axis=1)):.3f} px")
-    edges = [float(x) for x in a.age_bins.split(",")]
+    return a
+
+
+def without_lag(errs, min_speed):
+    """errs with the fitted along-motion lag added back at every point (printed)."""
+    ids = list(errs)
+    sizes = [len(errs[fid][0]) for fid in ids]
+    e_all, lag_a, lag_tau = remove_lag(np.concatenate([errs[fid][1] for fid in ids]),
+                                       np.concatenate([errs[fid][3] for fid in ids]), min_speed)
+    out = {}
+    for fid, part in zip(ids, np.split(e_all, np.cumsum(sizes)[:-1])):
+        t, _, age, v = errs[fid]
+        out[fid] = (t, part, age, v)
+    print(f"lag removed: a = {lag_a:.3f} px, tau = {lag_tau * 1e3:.2f} ms")
+    return out
+
+
+def print_age_bins(e, age, edges):
+    """Per age bin: RMS and median |e|, robust variance; then the drift fit."""
     print("age bin (s)      points  RMS |e| (px)  median |e| (px)  robust var x, y (px²)")
     mean_age, var, weight = [], [], []
     for lo, hi in zip(edges[:-1], edges[1:]):
@@ -295,14 +292,21 @@ def main():
         A = np.stack([np.ones(len(var)), np.array(mean_age)], axis=1)
         (v0, q), *_ = np.linalg.lstsq(A * w[:, None], np.array(var) * w, rcond=None)
         print(f"per-axis variance ≈ {v0:.3f} px² + {q:.3f} px²/s · age")
+
+
+def print_tails(errs, e, off_px, off_run):
     norm = np.linalg.norm(e, axis=1)
     print("points beyond 1 / 2 / 3 px: " + " / ".join(f"{100 * np.mean(norm > x):.1f} %" for x in (1, 2, 3)))
-    runs = off_runs(errs, a.off_px)
-    long_runs = runs[runs >= a.off_run]
-    print(f"runs beyond {a.off_px:g} px: {len(runs)}; {len(long_runs)} of at least {a.off_run} points, "
+    runs = off_runs(errs, off_px)
+    long_runs = runs[runs >= off_run]
+    print(f"runs beyond {off_px:g} px: {len(runs)}; {len(long_runs)} of at least {off_run} points, "
           f"holding {int(long_runs.sum())} points")
+
+
+def print_correlations(errs, e, lags, equivalent_at):
+    """c(L) at the lags, the integrated time T and, with equivalent_at > 0, σ sqrt(T/τ)."""
     print("lag (s)  corr e(t)   pairs    corr e(t)-e(t0)")
-    lags, corr = [float(x) for x in a.lags.split(",")], []
+    corr = []
     for lag in lags:
         c, n = correlation(errs, lag, False)
         c0, _ = correlation(errs, lag, True)
@@ -312,21 +316,48 @@ def main():
     print(f"integrated correlation time {T * 1e3:.1f} ms " +
           {"zero": "(to its first zero)", "lags": f"(no zero within the lags, to {max(lags) * 1e3:g} ms)",
            "no pairs": "(to the last lag with pairs)"}[end])
-    if a.equivalent_at > 0:
+    if equivalent_at > 0:
         sigma = np.sqrt(np.mean(e ** 2))
-        print(f"sigma to state with an exponential weighting of {a.equivalent_at * 1e3:g} ms: "
-              f"{sigma * np.sqrt(T / a.equivalent_at):.2f} px (RMS {sigma:.3f} px per axis)")
+        print(f"sigma to state with an exponential weighting of {equivalent_at * 1e3:g} ms: "
+              f"{sigma * np.sqrt(T / equivalent_at):.2f} px (RMS {sigma:.3f} px per axis)")
+
+
+def print_common(errs, bin_s, min_features, lag_bins):
+    """The shared part: its variance against independent errors, then k bins apart."""
+    bins, features, common, independent = common_mode(errs, bin_s, min_features)
+    print(f"common to the features, bins of {bin_s * 1e3:g} ms: {bins} bins, {features:g} features per bin; "
+          f"all-feature mean {common:.4f} px² per axis, {independent:.4f} if independent, "
+          f"ratio {common / independent:.2f}")
+    shared0 = common - independent
+    for k in lag_bins:
+        pairs, cov = shared_covariance(errs, bin_s, min_features, k)
+        corr_text = f"correlation {cov / shared0:.2f}" if shared0 > 0 else "no shared variance at lag 0"
+        print(f"shared part {k} bins ({k * bin_s * 1e3:g} ms) apart: {pairs} pairs, covariance "
+              f"{cov:.4f} px² per axis, {corr_text}")
+
+
+def main():
+    a = parse_args()
+    errs = errors(read_points(a.tracks), read_points(a.truth), a.skip_s)
+    if not errs:
+        sys.exit("no track has a truth")
+    n_all = sum(len(v[0]) for v in errs.values())
+    for fid, (t, e, age, v) in list(errs.items()):
+        keep = np.linalg.norm(e, axis=1) <= a.max_error
+        errs[fid] = (t[keep], e[keep], age[keep], v[keep])
+    if a.lag_model:
+        errs = without_lag(errs, a.min_speed)
+    e = np.concatenate([v[1] for v in errs.values()])
+    age = np.concatenate([v[2] for v in errs.values()])
+    print(f"tracks {len(errs)}  points {n_all}, {len(e)} with |e| <= {a.max_error} px")
+    print(f"RMS error x {np.sqrt(np.mean(e[:, 0] ** 2)):.3f} px  y {np.sqrt(np.mean(e[:, 1] ** 2)):.3f} px  "
+          f"median |e| {np.median(np.linalg.norm(e, axis=1)):.3f} px")
+    print_age_bins(e, age, [float(x) for x in a.age_bins.split(",")])
+    print_tails(errs, e, a.off_px, a.off_run)
+    print_correlations(errs, e, [float(x) for x in a.lags.split(",")], a.equivalent_at)
     if a.common_bin > 0:
-        bins, features, common, independent = common_mode(errs, a.common_bin, a.common_min_features)
-        print(f"common to the features, bins of {a.common_bin * 1e3:g} ms: {bins} bins, {features:g} features per bin; "
-              f"all-feature mean {common:.4f} px² per axis, {independent:.4f} if independent, "
-              f"ratio {common / independent:.2f}")
-        shared0 = common - independent
-        for k in (int(x) for x in a.common_lags.split(",") if x.strip()):
-            pairs, cov = shared_covariance(errs, a.common_bin, a.common_min_features, k)
-            corr_text = f"correlation {cov / shared0:.2f}" if shared0 > 0 else "no shared variance at lag 0"
-            print(f"shared part {k} bins ({k * a.common_bin * 1e3:g} ms) apart: {pairs} pairs, covariance "
-                  f"{cov:.4f} px² per axis, {corr_text}")
+        print_common(errs, a.common_bin, a.common_min_features,
+                     [int(x) for x in a.common_lags.split(",") if x.strip()])
 
 
 if __name__ == "__main__":

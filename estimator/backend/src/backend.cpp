@@ -59,6 +59,11 @@ Eigen::Matrix<double, 15, 15> Backend::initialCovariance() const {
   return P0;
 }
 
+Mat2 Backend::normalisedCovariance(double sigma_px) const {
+  const Vec4 k = sensors_.camera.intrinsics();  // fx fy cx cy: normalised = px / f
+  return Vec2(sigma_px * sigma_px / (k(0) * k(0)), sigma_px * sigma_px / (k(1) * k(1))).asDiagonal();
+}
+
 void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 15>& P0) {
   require(state.p_W_B.allFinite() && state.v_W.allFinite() && state.q_W_B.coeffs().allFinite() &&
               state.b_g.allFinite() && state.b_a.allFinite(),
@@ -66,21 +71,15 @@ void Backend::initialize(const ImuState& state, const Eigen::Matrix<double, 15, 
   require(P0.allFinite(), "Backend::initialize: the initial covariance is not finite");
   state_ = FilterState();
   if (options_.slam_track_error_sigma_px > 0.0) {
-    const Vec4 k = sensors_.camera.intrinsics();  // fx fy cx cy: normalised = px / f
-    const double s = options_.slam_track_error_sigma_px;
     state_.feature_dim = kFeatureDim + kTrackErrorDim;
-    state_.track_error_cov = Vec2(s * s / (k(0) * k(0)), s * s / (k(1) * k(1))).asDiagonal();
+    state_.track_error_cov = normalisedCovariance(options_.slam_track_error_sigma_px);
     state_.track_error_time_s = options_.slam_track_error_time_s;
   }
   state_.imu = state;
   state_.imu.q_W_B.normalize();
   state_.P = 0.5 * (P0 + P0.transpose());
-  if (options_.slam_image_shift_sigma_px > 0.0) {
-    const Vec4 k = sensors_.camera.intrinsics();  // fx fy cx cy: normalised = px / f
-    const double s = options_.slam_image_shift_sigma_px;
-    state_.addImageShift(Vec2(s * s / (k(0) * k(0)), s * s / (k(1) * k(1))).asDiagonal(),
-                         options_.slam_image_shift_time_s);
-  }
+  if (options_.slam_image_shift_sigma_px > 0.0)
+    state_.addImageShift(normalisedCovariance(options_.slam_image_shift_sigma_px), options_.slam_image_shift_time_s);
   fej_imu_ = state_.imu;
   initialized_ = true;
   tracks_.clear();

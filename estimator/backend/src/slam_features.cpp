@@ -64,26 +64,32 @@ bool slamSecondOrderCovariance(const FilterState& state, std::size_t j, std::siz
   return cov->allFinite();
 }
 
+namespace {
+
+// One exact first-order Gauss–Markov step of the 2-vector x whose error
+// block starts at P's index k, φ = exp(−Δt/τ), stationary covariance Σ:
+//   x ← φ x,  P's rows and columns k, k+1 × φ,  P_kk += (1 − φ²) Σ.
+void gaussMarkovStep(MatX& P, int k, double phi, const Mat2& stationary, Vec2* x) {
+  *x *= phi;
+  P.middleRows(k, 2) *= phi;
+  P.middleCols(k, 2) *= phi;
+  P.block<2, 2>(k, k) += (1.0 - phi * phi) * stationary;
+}
+
+}  // namespace
+
 void decayTrackErrors(FilterState& state, double dt_s, double time_s) {
   if (!state.hasTrackErrors() || !(dt_s > 0.0)) return;
   const double phi = std::exp(-dt_s / time_s);
-  for (std::size_t j = 0; j < state.features.size(); ++j) {
-    const int k = state.featureIndex(j) + kFeatureDim;
-    state.features[j].track_error *= phi;
-    state.P.middleRows(k, kTrackErrorDim) *= phi;
-    state.P.middleCols(k, kTrackErrorDim) *= phi;
-    state.P.block<2, 2>(k, k) += (1.0 - phi * phi) * state.track_error_cov;
-  }
+  for (std::size_t j = 0; j < state.features.size(); ++j)
+    gaussMarkovStep(state.P, state.featureIndex(j) + kFeatureDim, phi, state.track_error_cov,
+                    &state.features[j].track_error);
 }
 
 void decayImageShift(FilterState& state, double dt_s) {
   if (!state.has_image_shift || !(dt_s > 0.0)) return;
-  const double phi = std::exp(-dt_s / state.image_shift_time_s);
-  const int k = state.imageShiftIndex();
-  state.image_shift *= phi;
-  state.P.middleRows(k, kImageShiftDim) *= phi;
-  state.P.middleCols(k, kImageShiftDim) *= phi;
-  state.P.block<2, 2>(k, k) += (1.0 - phi * phi) * state.image_shift_cov;
+  gaussMarkovStep(state.P, state.imageShiftIndex(), std::exp(-dt_s / state.image_shift_time_s),
+                  state.image_shift_cov, &state.image_shift);
 }
 
 Mat2 whitenWithExtraCovariance(const Mat2& whiten, double sigma_z, const Mat2& extra) {

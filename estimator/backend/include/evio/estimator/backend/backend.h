@@ -110,6 +110,8 @@ class Backend {
   std::size_t numPending() const { return pending_.size(); }
 
  private:
+  /// diag(σ²/f_x², σ²/f_y²): a per-axis pixel σ as a covariance in normalised image units.
+  Mat2 normalisedCovariance(double sigma_px) const;
   struct RangeItem {
     double range_m;
   };

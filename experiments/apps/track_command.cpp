@@ -49,7 +49,8 @@ void addTrackCommand(CLI::App& app) {
                 "cov_xy cov_yy, px^2)");
   cmd->add_flag("--lag-compensated", args->lag_compensated,
                 "also write <output>.lag_compensated.txt (id t x y): each point moved forward by the lag estimated "
-                "online from the frames so far, as the filter is given it (EKLT, HASTE)");
+                "online from the frames so far, as the filter is given it (EKLT, HASTE; EKLT's points measured on frames, its "
+                "detections and bootstraps, are left as they are)");
   cmd->add_option("--lag-velocity-window", args->lag_velocity_window_s,
                   "with --lag-compensated: each track's velocity fitted over its points of this last span, s (the "
                   "synchroniser's velocity_window_s; 0: its newest two points)")

@@ -67,11 +67,14 @@ With --lag-model the tracker's along-motion lag a + τ|v| is fitted and
 added back along v̂ at every point first (as track_noise_stats.py does, v the
 central difference of the true positions): what remains is the error the
 filter meets, since it compensates that lag (docs/algorithms.md "Tracker
-lag").
+lag"). With --frames images.txt as well, the points stamped at a frame's
+time (to the nanosecond: EKLT's detections and bootstraps, measured on the
+frames) do not lag: they are left out of the fit and left as they are, as
+the synchroniser leaves them.
 
 Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
        [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
-       [--off-px 2] [--off-run 10] [--lag-model] [--min-speed 50]
+       [--off-px 2] [--off-run 10] [--lag-model] [--min-speed 50] [--frames images.txt]
        [--common-bin 0.01] [--common-min-features 8] [--common-lags 1,2,5,10]
        [--equivalent-at 0.042]
 """
@@ -246,6 +249,8 @@ def parse_args():
     ap.add_argument("--off-run", type=int, default=10, help="count runs of at least this many off points")
     ap.add_argument("--lag-model", action="store_true", help="remove the fitted along-motion lag a + tau |v| first")
     ap.add_argument("--min-speed", type=float, default=50.0, help="px/s: the lag fit's points (as track_lag.py)")
+    ap.add_argument("--frames", default="", help="with --lag-model: the sequence's images.txt; points at its "
+                    "times were measured on frames and carry no lag")
     ap.add_argument("--common-bin", type=float, default=0.0, help="s: measure the error common to the features (0: off)")
     ap.add_argument("--common-min-features", type=int, default=8, help="bins with fewer features are left out")
     ap.add_argument("--common-lags", default="", help="bins: the shared part's covariance this many bins apart")
@@ -256,15 +261,33 @@ def parse_args():
         sys.exit("track_error_stats: --common-lags needs --common-bin")
     if a.common_min_features < 2:
         sys.exit("track_error_stats: --common-min-features must be at least 2 (a spread needs two features)")
+    if a.frames and not a.lag_model:
+        sys.exit("track_error_stats: --frames needs --lag-model")
     return a
 
 
-def without_lag(errs, min_speed):
-    """errs with the fitted along-motion lag added back at every point (printed)."""
+def frame_times_ns(images_txt):
+    """The frames' times, integer ns, from an images.txt (`t path` lines)."""
+    times = []
+    with open(images_txt) as f:
+        for line in f:
+            if line.strip() and not line.startswith("#"):
+                times.append(round(float(line.split()[0]) * 1e9))
+    return np.array(times, dtype=np.int64)
+
+
+def without_lag(errs, min_speed, frames_ns):
+    """errs with the fitted along-motion lag added back at every point that
+    lags, those not stamped at a frame's time (printed)."""
     ids = list(errs)
     sizes = [len(errs[fid][0]) for fid in ids]
-    e_all, lag_a, lag_tau = remove_lag(np.concatenate([errs[fid][1] for fid in ids]),
-                                       np.concatenate([errs[fid][3] for fid in ids]), min_speed)
+    t_all = np.concatenate([errs[fid][0] for fid in ids])
+    lags = ~np.isin(np.round(t_all * 1e9).astype(np.int64), frames_ns)
+    e_all = np.concatenate([errs[fid][1] for fid in ids])
+    e_all[lags], lag_a, lag_tau = remove_lag(e_all[lags], np.concatenate([errs[fid][3] for fid in ids])[lags],
+                                             min_speed)
+    if not lags.all():
+        print(f"points measured on frames, left as they are: {int((~lags).sum())}")
     out = {}
     for fid, part in zip(ids, np.split(e_all, np.cumsum(sizes)[:-1])):
         t, _, age, v = errs[fid]
@@ -346,7 +369,8 @@ def main():
         keep = np.linalg.norm(e, axis=1) <= a.max_error
         errs[fid] = (t[keep], e[keep], age[keep], v[keep])
     if a.lag_model:
-        errs = without_lag(errs, a.min_speed)
+        frames = frame_times_ns(a.frames) if a.frames else np.array([], dtype=np.int64)
+        errs = without_lag(errs, a.min_speed, frames)
     e = np.concatenate([v[1] for v in errs.values()])
     age = np.concatenate([v[2] for v in errs.values()])
     print(f"tracks {len(errs)}  points {n_all}, {len(e)} with |e| <= {a.max_error} px")

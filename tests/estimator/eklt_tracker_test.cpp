@@ -264,9 +264,14 @@ TEST(EkltTracker, DetectsBootstrapsAndTracksFromFrames) {
   TrackPoints points;
   tracker.drainTrackPoints(points);
   std::map<FeatureId, Vec2> origin;  // texture point of the detection
+  std::map<FeatureId, int> seen;     // points of each track so far
   int tracked = 0;
   double sum_err = 0.0;
   for (const TrackPoint& p : points) {
+    // The detection and the bootstrap are measured on frames, every later
+    // point on events (TrackPoint::measured_on_frame).
+    if (p.status != TrackStatus::kLost)
+      EXPECT_EQ(p.measured_on_frame, seen[p.feature_id]++ < 2) << "feature " << p.feature_id;
     if (p.status == TrackStatus::kNew) {
       origin[p.feature_id] = m.inverse(p.uv, nsToSeconds(p.t_ns));
       continue;

@@ -191,6 +191,43 @@ TEST(Synchronizer, CompensatesALagInDistanceAndTimeAtAnySpeed) {
   EXPECT_THROW(Synchronizer{o}, Error);
 }
 
+// EKLT measures a track's first two points on frames (its detection and its
+// bootstrap on the next frame), at the frames' times: they do not lag. A set
+// whose newest point for a track is such a point sends the exact linear
+// extrapolation, with neither the lag distance a nor the latency τ added;
+// once event points (lagged by a + τ|v|) are the newest, both are
+// compensated again. Exact on a line, to 1e-9 px.
+TEST(Synchronizer, CompensatesNoLagForPointsMeasuredOnFrames) {
+  const double a = 0.4, tau = 0.0013;
+  const Vec2 uv0(40, 30), v(300, -200);  // px, px/s
+  const auto onFrame = [&](double t, TrackStatus st) {
+    TrackPoint p = point(7, t, linear(uv0, v, t), st);
+    p.measured_on_frame = true;
+    return p;
+  };
+  for (const double window : {0.0, 0.02}) {
+    SynchronizerOptions o;
+    o.n_e = 10;
+    o.track_latency_s = tau;
+    o.track_lag_px = a;
+    o.velocity_window_s = window;
+    Synchronizer sync(o);
+    sync.addTrackPoints({onFrame(0.000, TrackStatus::kNew), onFrame(0.046, TrackStatus::kTracked)});
+    sync.addEvents(10, secondsToNs(0.048));
+    MeasurementSet set;
+    ASSERT_TRUE(sync.poll(&set));
+    ASSERT_EQ(set.features.size(), 1u);
+    EXPECT_LT((set.features[0].uv - linear(uv0, v, 0.046)).norm(), 1e-9) << "window " << window;
+    // Event points, each lagging by τ and a, 24 and 26 ms after the bootstrap
+    // (so that the velocity comes from lagged points alone, in either window).
+    const auto lagged = [&](double t) { return point(7, t, linear(uv0, v, t - tau) - a * v.normalized()); };
+    sync.addTrackPoints({lagged(0.070), lagged(0.072)});
+    sync.addEvents(10, secondsToNs(0.073));
+    ASSERT_TRUE(sync.poll(&set));
+    EXPECT_LT((set.features[0].uv - linear(uv0, v, 0.072)).norm(), 1e-9) << "window " << window;
+  }
+}
+
 // A fitted velocity carries less of a noisy track's point noise into what
 // is sent: nine points 2.5 ms apart, each off by σ = 0.5 px per axis (about
 // EKLT's on the campaign cells), a latency τ = 2 ms compensated. The set

@@ -101,6 +101,40 @@ class TrackErrorLagModel(unittest.TestCase):
             self.assertIn("RMS error x 0.000 px  y 0.000 px", r.stdout)
 
 
+    def test_points_measured_on_frames_are_left_out_of_the_lag(self):
+        # Two tracks at 100 and 300 px/s along x start with two points on
+        # frames (t = 0 and 0.05 s, listed in images.txt), exactly on their
+        # truth, then trail it by a + tau |v| (a = 0.5 px, tau = 2 ms). With
+        # --frames the fit takes the event points alone and recovers a and
+        # tau exactly, and nothing is left; without it the frame points'
+        # zero lag pulls the fit off and leaves an error.
+        a, tau = 0.5, 0.002
+        with tempfile.TemporaryDirectory() as root:
+            tracks, truth = os.path.join(root, "t.txt"), os.path.join(root, "truth.txt")
+            images = os.path.join(root, "images.txt")
+            with open(images, "w") as f:
+                f.write("# timestamp filename\n0.000000000 images/0.png\n0.050000000 images/1.png\n")
+            rows_t, rows_g = [], []
+            for fid, vx in ((1, 100.0), (2, 300.0)):
+                for k, t in enumerate([0.0, 0.05] + [0.052 + 0.004 * j for j in range(40)]):
+                    x = 20.0 + vx * t
+                    rows_g.append((fid, t, x, 30.0))
+                    rows_t.append((fid, t, x if k < 2 else x - (a + tau * vx), 30.0))
+            write(tracks, rows_t)
+            write(truth, rows_g)
+            r = run(tracks, truth, "--lag-model", "--frames", images)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("lag removed: a = 0.500 px, tau = 2.00 ms", r.stdout)
+            self.assertIn("points measured on frames, left as they are: 4", r.stdout)
+            self.assertIn("RMS error x 0.000 px  y 0.000 px", r.stdout)
+            plain = run(tracks, truth, "--lag-model")
+            self.assertEqual(plain.returncode, 0, plain.stderr)
+            self.assertNotIn("RMS error x 0.000 px", plain.stdout)
+            refused = run(tracks, truth, "--frames", images)
+            self.assertNotEqual(refused.returncode, 0)
+            self.assertIn("--frames needs --lag-model", refused.stderr)
+
+
 class TrackErrorCommonMode(unittest.TestCase):
     def test_a_shift_shared_by_every_feature_is_measured_exactly(self):
         # Ten still features, one point each in four 10 ms bins. Along x every

@@ -19,6 +19,14 @@ namespace {
 
 double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
+/// A point EKLT took from a frame (a detection, a bootstrap), stamped at the
+/// frame's time: it carries no event lag (TrackPoint::measured_on_frame).
+TrackPoint framePoint(FeatureId id, TimeNs t_ns, const Vec2& uv, TrackStatus status) {
+  TrackPoint p{id, t_ns, uv, 1.0, status};
+  p.measured_on_frame = true;
+  return p;
+}
+
 }  // namespace
 
 void EkltOptions::validate() const {
@@ -210,7 +218,7 @@ FeatureId EkltTracker::addFeature(const cv::Mat& log_image, const Vec2& x0, cons
   s.theta = theta_rad;
   assignTemplate(s, gx, gy, x0);
   activate(index, uv, t_ns, flow_angle_rad);
-  out_.push_back(TrackPoint{s.id, t_ns, uv, 1.0, TrackStatus::kNew});
+  out_.push_back(framePoint(s.id, t_ns, uv, TrackStatus::kNew));
   return s.id;
 }
 
@@ -466,9 +474,9 @@ void EkltTracker::addFrame(TimeNs t_ns, const cv::Mat& image) {
       }
       const Vec2 flow = uv - s.x0;
       s.theta = 0.0;
-      out_.push_back(TrackPoint{s.id, s.t_detect_ns, s.x0, 1.0, TrackStatus::kNew});
+      out_.push_back(framePoint(s.id, s.t_detect_ns, s.x0, TrackStatus::kNew));
       activate(index, uv, t_ns, std::atan2(flow.y(), flow.x()));
-      out_.push_back(TrackPoint{s.id, t_ns, uv, 1.0, TrackStatus::kTracked});
+      out_.push_back(framePoint(s.id, t_ns, uv, TrackStatus::kTracked));
     }
   }
   timing_.bootstrap_s += t_boot.seconds();

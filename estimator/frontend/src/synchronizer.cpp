@@ -49,6 +49,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
         tr.uv[1] = p.uv;
         tr.cov = p.cov_px;
         tr.error_time_s = p.error_time_s;
+        tr.newest_on_frame = p.measured_on_frame;
         tr.moved = true;
       }
       continue;
@@ -59,6 +60,7 @@ void Synchronizer::addTrackPoints(const TrackPoints& points) {
     tr.uv[1] = p.uv;
     tr.cov = p.cov_px;
     tr.error_time_s = p.error_time_s;
+    tr.newest_on_frame = p.measured_on_frame;
     tr.n = std::min(tr.n + 1, 2);
     tr.moved = true;
     newest = std::max(newest, p.t_ns);
@@ -118,18 +120,18 @@ void Synchronizer::setTrackLag(double a_px, double tau_s) {
   latency_ns_ = secondsToNs(std::max(0.0, tau_s));
 }
 
-Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns) const {
+Vec2 Synchronizer::extrapolate(const Track& tr, TimeNs t_ns, double lag_px) const {
   if (tr.n < 2 || tr.t[1] == tr.t[0]) return tr.uv[1];
   const TimeNs horizon = secondsToNs(options_.max_extrapolation_s);
   const TimeNs t = std::min(t_ns, tr.t[1] + horizon);
   if (options_.velocity_window_s > 0.0) {
     // uv1 + v (t − t1) + a v/|v|: the newest point moved along the fitted velocity.
-    if (const auto v = tr.velocity.velocity()) return moveAlongVelocity(tr.uv[1], *v, nsToSeconds(t - tr.t[1]), lag_px_);
+    if (const auto v = tr.velocity.velocity()) return moveAlongVelocity(tr.uv[1], *v, nsToSeconds(t - tr.t[1]), lag_px);
   }
   const Vec2 step = tr.uv[1] - tr.uv[0];
   const double length = step.norm();
   // The lag in distance, a px along the direction of the last step.
-  const Vec2 lag = length > 0.0 ? Vec2(lag_px_ / length * step) : Vec2::Zero();
+  const Vec2 lag = length > 0.0 ? Vec2(lag_px / length * step) : Vec2::Zero();
   return extrapolateLinearly(tr.t[0], tr.uv[0], tr.t[1], tr.uv[1], t) + lag;
 }
 
@@ -141,7 +143,8 @@ void Synchronizer::update(TimeNs t_ns) {
     Track& tr = tracks_.at(id);
     FeatureMeasurement m;
     m.id = id;
-    m.uv = extrapolate(tr, t_ns + latency_ns_);
+    // A point measured on a frame does not lag: no latency, no lag distance.
+    m.uv = tr.newest_on_frame ? extrapolate(tr, t_ns, 0.0) : extrapolate(tr, t_ns + latency_ns_, lag_px_);
     m.cov_px = tr.cov;
     m.error_time_s = tr.error_time_s;
     m.informative = (!options_.drop_repeated_points || tr.moved) &&

@@ -52,6 +52,11 @@ struct TrackPoint {
   /// states it (its option error_time_s): the error of points Δt apart is
   /// correlated as e^(−Δt/τ). 0: independent from point to point.
   double error_time_s = 0.0;
+  /// The tracker measured this point on a frame, at the frame's time (EKLT's
+  /// detection and its bootstrap on the next frame), not from events: it
+  /// carries none of the event tracker's lag, so the synchroniser does not
+  /// compensate one.
+  bool measured_on_frame = false;
 };
 
 using TrackPoints = std::vector<TrackPoint>;

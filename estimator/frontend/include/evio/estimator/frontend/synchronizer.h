@@ -25,7 +25,14 @@
 /// velocity_window_s (held when it has one point; at most
 /// max_extrapolation_s beyond its last point), and carries the position it
 /// was sent with at the previous update and the covariance and error time
-/// constant its tracker stated for its newest point.
+/// constant its tracker stated for its newest point. The tracker's lag
+/// (track_latency_s τ, track_lag_px a: moved a px further along the motion
+/// and extrapolated τ later) is compensated only when that newest point came
+/// from events: a point measured on a frame (TrackPoint::measured_on_frame,
+/// EKLT's detection and bootstrap) does not lag. (Until the bootstrap leaves
+/// the velocity window, the velocity is fitted over points with and without
+/// the lag: on a line at speed |v| its slope is off by about
+/// (a + τ|v|) / span for the first event points.)
 
 #include <cstdint>
 #include <deque>
@@ -121,6 +128,7 @@ class Synchronizer {
     TimeNs t[2] = {0, 0};   // last two points, t[1] newest
     Vec2 uv[2] = {Vec2::Zero(), Vec2::Zero()};
     Mat2 cov = Mat2::Zero();  // of the newest point, px² (zero: not stated)
+    bool newest_on_frame = false;  // the newest point was measured on a frame: no lag
     double error_time_s = 0.0;  // of the newest point (TrackPoint::error_time_s)
     bool informed = false;    // an informative position was sent
     Vec2 last_informative = Vec2::Zero();
@@ -131,7 +139,8 @@ class Synchronizer {
     TrackVelocity velocity;   // fitted over velocity_window_s (kept only when it is > 0)
   };
   enum class Trigger { kEvents, kFixedRate, kTrackTime };
-  Vec2 extrapolate(const Track& track, TimeNs t_ns) const;
+  /// The track at t_ns, its newest point moved lag_px further along the motion.
+  Vec2 extrapolate(const Track& track, TimeNs t_ns, double lag_px) const;
   void update(TimeNs t_ns);
   TimeNs latestTrackTime() const;
 

@@ -70,7 +70,9 @@ filter meets, since it compensates that lag (docs/algorithms.md "Tracker
 lag"). With --frames images.txt as well, the points stamped at a frame's
 time (to the nanosecond: EKLT's detections and bootstraps, measured on the
 frames) do not lag: they are left out of the fit and left as they are, as
-the synchroniser leaves them.
+the synchroniser leaves them. (An event point is stamped at the middle of
+its batch; one that fell on a frame's nanosecond would be taken for a frame
+point too.)
 
 Usage: track_error_stats.py TRACKS TRUTH [--lags 0.01,0.1,0.4,0.8]
        [--age-bins 0,0.1,0.4,1.6,100] [--max-error 5] [--skip-s 0]
@@ -282,12 +284,13 @@ def without_lag(errs, min_speed, frames_ns):
     ids = list(errs)
     sizes = [len(errs[fid][0]) for fid in ids]
     t_all = np.concatenate([errs[fid][0] for fid in ids])
-    lags = ~np.isin(np.round(t_all * 1e9).astype(np.int64), frames_ns)
+    lagging = ~np.isin(np.round(t_all * 1e9).astype(np.int64), frames_ns)
     e_all = np.concatenate([errs[fid][1] for fid in ids])
-    e_all[lags], lag_a, lag_tau = remove_lag(e_all[lags], np.concatenate([errs[fid][3] for fid in ids])[lags],
-                                             min_speed)
-    if not lags.all():
-        print(f"points measured on frames, left as they are: {int((~lags).sum())}")
+    v_all = np.concatenate([errs[fid][3] for fid in ids])
+    e_compensated, lag_a, lag_tau = remove_lag(e_all[lagging], v_all[lagging], min_speed)
+    e_all[lagging] = e_compensated
+    if not lagging.all():
+        print(f"points measured on frames, left as they are: {int((~lagging).sum())}")
     out = {}
     for fid, part in zip(ids, np.split(e_all, np.cumsum(sizes)[:-1])):
         t, _, age, v = errs[fid]

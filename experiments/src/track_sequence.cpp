@@ -173,13 +173,13 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
   double busy = 0.0;
   // A point measured on a frame (EKLT's detection and bootstrap) does not lag,
   // as the synchroniser takes it.
-  const auto compensate = [&](const io::TrackSample& sample, bool measured_on_frame) {
-    io::TrackSample out = sample;
-    auto [it, inserted] = velocities.try_emplace(sample.id, compensate_lag->velocity_window_s);
-    it->second.add(sample.t_ns, sample.uv);
+  const auto compensate = [&](const estimator::TrackPoint& p) {
+    io::TrackSample out{p.feature_id, p.t_ns, p.uv};
+    auto [it, inserted] = velocities.try_emplace(p.feature_id, compensate_lag->velocity_window_s);
+    it->second.add(p.t_ns, p.uv);
     const auto lag = frontend.trackLag();  // the estimate as the points leave the frontend
     const auto v = it->second.velocity();
-    if (lag && v && !measured_on_frame) out.uv = lagCompensated(*lag, sample.uv, *v);
+    if (lag && v && !p.measured_on_frame) out.uv = lagCompensated(*lag, p.uv, *v);
     result.compensated.push_back(out);
   };
   const auto collect = [&] {
@@ -197,7 +197,7 @@ TrackSequenceResult trackSequence(const std::string& folder, const estimator::Fr
       }
       result.samples.push_back(io::TrackSample{p.feature_id, p.t_ns, p.uv});
       result.noise.push_back(io::TrackNoiseSample{p.feature_id, p.t_ns, p.quality, p.cov_px});
-      if (compensate_lag) compensate(result.samples.back(), p.measured_on_frame);
+      if (compensate_lag) compensate(p);
     }
   };
   const auto feedImuUntil = [&](TimeNs t) {

@@ -270,8 +270,9 @@ TEST(EkltTracker, DetectsBootstrapsAndTracksFromFrames) {
   for (const TrackPoint& p : points) {
     // The detection and the bootstrap are measured on frames, every later
     // point on events (TrackPoint::measured_on_frame).
-    if (p.status != TrackStatus::kLost)
+    if (p.status != TrackStatus::kLost) {
       EXPECT_EQ(p.measured_on_frame, seen[p.feature_id]++ < 2) << "feature " << p.feature_id;
+    }
     if (p.status == TrackStatus::kNew) {
       origin[p.feature_id] = m.inverse(p.uv, nsToSeconds(p.t_ns));
       continue;

@@ -243,6 +243,43 @@ TEST(Frontend, TrackPointsStateTheirTrackersErrorTimeConstant) {
   }
 }
 
+// EKLT's detections and bootstraps on sensor frames are marked measured on
+// a frame (they carry no event lag); on images rebuilt from events they lag
+// as the events do, so the frontend leaves them unmarked.
+TEST(Frontend, EkltPointsAreMeasuredOnFramesOnlyOnSensorFrames) {
+  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+  cv::Mat image(180, 240, CV_8UC1, cv::Scalar(20));
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 5; ++c) image(cv::Rect(30 + 40 * c, 25 + 35 * r, 16, 16)).setTo(cv::Scalar(220));
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);
+  // Ten events at one corner pixel, away from the squares, from t0 on.
+  const auto events = [](double t0) {
+    EventArray ev;
+    for (int i = 0; i < 10; ++i) ev.push_back(secondsToNs(t0 + 1e-4 * i), 0, 0, i % 2 == 0);
+    return ev;
+  };
+  const auto pointsOf = [&](const std::string& source) {
+    FrontendOptions options;
+    options.tracker = "eklt";
+    options.image_source = source;
+    options.reconstruction.output_every_events = 10;  // one image per addEvents below
+    Frontend frontend(options, cam);
+    frontend.addFrame(secondsToNs(0.1), image);  // reconstructed: fused into the image
+    frontend.addEvents(events(0.11));
+    if (source == "frames") frontend.addFrame(secondsToNs(0.15), image);
+    frontend.addEvents(events(0.15));
+    TrackPoints points;
+    frontend.drainTrackPoints(points);
+    return points;
+  };
+  const TrackPoints on_frames = pointsOf("frames");
+  const TrackPoints rebuilt = pointsOf("reconstructed");
+  ASSERT_FALSE(on_frames.empty());
+  ASSERT_FALSE(rebuilt.empty());
+  for (const TrackPoint& p : on_frames) EXPECT_TRUE(p.measured_on_frame) << "feature " << p.feature_id;
+  for (const TrackPoint& p : rebuilt) EXPECT_FALSE(p.measured_on_frame) << "feature " << p.feature_id;
+}
+
 // KLT states the σ of its section (position_sigma_px) as each point's
 // covariance σ² I; without it a point states none (the backend's σ_img).
 // EKLT keeps the covariance of its own fit whatever KLT's section says.

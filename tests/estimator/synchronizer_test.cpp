@@ -194,16 +194,21 @@ TEST(Synchronizer, CompensatesALagInDistanceAndTimeAtAnySpeed) {
 // EKLT measures a track's first two points on frames (its detection and its
 // bootstrap on the next frame), at the frames' times: they do not lag. A set
 // whose newest point for a track is such a point sends the exact linear
-// extrapolation, with neither the lag distance a nor the latency τ added;
-// once event points (lagged by a + τ|v|) are the newest, both are
-// compensated again. Exact on a line, to 1e-9 px.
+// extrapolation, with neither the lag distance a nor the latency τ added:
+// track 7 at 48 ms, 2 ms past its bootstrap (the set's time comes from
+// track 8's newest point); track 9 the same, its bootstrap replacing a
+// lagged point of the same time. Once event points (lagged by a + τ|v|) are
+// the newest, both are compensated again. Exact on a line, to 1e-9 px.
 TEST(Synchronizer, CompensatesNoLagForPointsMeasuredOnFrames) {
   const double a = 0.4, tau = 0.0013;
   const Vec2 uv0(40, 30), v(300, -200);  // px, px/s
-  const auto onFrame = [&](double t, TrackStatus st) {
-    TrackPoint p = point(7, t, linear(uv0, v, t), st);
+  const auto onFrame = [&](FeatureId id, double t, TrackStatus st) {
+    TrackPoint p = point(id, t, linear(uv0, v, t), st);
     p.measured_on_frame = true;
     return p;
+  };
+  const auto lagged = [&](FeatureId id, double t) {
+    return point(id, t, linear(uv0, v, t - tau) - a * v.normalized());
   };
   for (const double window : {0.0, 0.02}) {
     SynchronizerOptions o;
@@ -212,19 +217,27 @@ TEST(Synchronizer, CompensatesNoLagForPointsMeasuredOnFrames) {
     o.track_lag_px = a;
     o.velocity_window_s = window;
     Synchronizer sync(o);
-    sync.addTrackPoints({onFrame(0.000, TrackStatus::kNew), onFrame(0.046, TrackStatus::kTracked)});
-    sync.addEvents(10, secondsToNs(0.048));
+    sync.addTrackPoints({onFrame(7, 0.000, TrackStatus::kNew), onFrame(9, 0.000, TrackStatus::kNew),
+                         onFrame(7, 0.046, TrackStatus::kTracked), lagged(9, 0.046),
+                         onFrame(9, 0.046, TrackStatus::kTracked), lagged(8, 0.030), lagged(8, 0.048)});
+    sync.addEvents(10, secondsToNs(0.049));
     MeasurementSet set;
     ASSERT_TRUE(sync.poll(&set));
-    ASSERT_EQ(set.features.size(), 1u);
-    EXPECT_LT((set.features[0].uv - linear(uv0, v, 0.046)).norm(), 1e-9) << "window " << window;
-    // Event points, each lagging by τ and a, 24 and 26 ms after the bootstrap
-    // (so that the velocity comes from lagged points alone, in either window).
-    const auto lagged = [&](double t) { return point(7, t, linear(uv0, v, t - tau) - a * v.normalized()); };
-    sync.addTrackPoints({lagged(0.070), lagged(0.072)});
+    ASSERT_EQ(set.t_ns, secondsToNs(0.048));
+    ASSERT_EQ(set.features.size(), 3u);
+    for (const FeatureMeasurement& m : set.features)
+      EXPECT_LT((m.uv - linear(uv0, v, 0.048)).norm(), 1e-9) << "feature " << m.id << ", window " << window;
+    // Event points of tracks 7 and 9, 24 and 26 ms after the bootstrap (so
+    // that the velocity comes from lagged points alone, in either window).
+    sync.addTrackPoints({lagged(7, 0.070), lagged(9, 0.070), lagged(7, 0.072), lagged(9, 0.072)});
     sync.addEvents(10, secondsToNs(0.073));
     ASSERT_TRUE(sync.poll(&set));
-    EXPECT_LT((set.features[0].uv - linear(uv0, v, 0.072)).norm(), 1e-9) << "window " << window;
+    ASSERT_EQ(set.t_ns, secondsToNs(0.072));
+    for (const FeatureMeasurement& m : set.features) {
+      if (m.id != 8) {
+        EXPECT_LT((m.uv - linear(uv0, v, 0.072)).norm(), 1e-9) << "feature " << m.id;
+      }
+    }
   }
 }
 

@@ -139,6 +139,46 @@ TEST(FrameLagProbe, RecoversAKnownLagFromFramesAndEventTracks) {
   EXPECT_NEAR(lag->tau_s, tau, 3e-4);
 }
 
+// The probe's event track is made of event points alone. Twelve features
+// are detected on the frame at 0 and bootstrapped on the frame at 20 ms
+// (points measured on frames, on the truth), then give one lagged event
+// point at 30 ms. At the frame at 40 ms no feature has two event points,
+// so no sample is taken: a line through the bootstrap and the lagged point
+// would not move at the feature's speed (with a = 0.4 px, τ = 1.5 ms at
+// 40 px/s it would put the sample about 0.46 px too far behind).
+TEST(FrameLagProbe, TakesNoSampleThroughAPointMeasuredOnAFrame) {
+  const double a = 0.4, tau = 0.0015;
+  const MovingTexture scene;
+  std::vector<Vec2> seeds;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j) seeds.emplace_back(40.0 + 30.0 * i, 40.0 + 25.0 * j);
+  const auto truth = [&](std::size_t i, double t) { return Vec2(seeds[i] + MovingTexture::offset(t)); };
+  const auto points = [&](double t, TrackStatus status, bool on_frame) {
+    TrackPoints out;
+    for (std::size_t i = 0; i < seeds.size(); ++i) {
+      const Vec2 lag = on_frame ? Vec2::Zero() : Vec2(a * MovingTexture::velocity(t).normalized());
+      TrackPoint p{static_cast<FeatureId>(i), secondsToNs(t), truth(i, on_frame ? t : t - tau) - lag, 1.0, status};
+      p.measured_on_frame = on_frame;
+      out.push_back(p);
+    }
+    return out;
+  };
+  TrackLagOptions o;
+  o.estimate = true;
+  FrameLagProbe probe(o);
+  probe.addFrame(0, scene.frame(0.0));
+  probe.observe(points(0.0, TrackStatus::kNew, true), 0);
+  probe.addFrame(secondsToNs(0.02), scene.frame(0.02));
+  probe.observe(points(0.02, TrackStatus::kTracked, true), 0);
+  probe.observe(points(0.03, TrackStatus::kTracked, false), 0);
+  probe.addFrame(secondsToNs(0.04), scene.frame(0.04));
+  EXPECT_EQ(probe.effectiveSamples(), 0.0);
+  // One more event point each, at 45 ms: the frame at 60 ms takes samples.
+  probe.observe(points(0.045, TrackStatus::kTracked, false), 0);
+  probe.addFrame(secondsToNs(0.06), scene.frame(0.06));
+  EXPECT_GT(probe.effectiveSamples(), 0.0);
+}
+
 TEST(FrameLagProbe, NoLagWithoutSamples) {
   FrameLagProbe probe(TrackLagOptions{});
   EXPECT_FALSE(probe.lag().has_value());

@@ -103,6 +103,7 @@ void Frontend::drainTrackPoints(TrackPoints& out) {
   const std::size_t begin = out.size();
   tracker_->drainTrackPoints(out);
   stateNoise(out, begin);
+  unmarkReconstructedFramePoints(out, begin);
   if (probe_) probe_->observe(out, begin);
 }
 
@@ -112,6 +113,11 @@ void Frontend::stateNoise(TrackPoints& points, std::size_t begin) const {
     points[i].error_time_s = error_time_s_;
     if (position_sigma_px_ > 0.0 && points[i].cov_px == Mat2::Zero()) points[i].cov_px = stated;
   }
+}
+
+void Frontend::unmarkReconstructedFramePoints(TrackPoints& points, std::size_t begin) const {
+  if (!reconstructor_) return;
+  for (std::size_t i = begin; i < points.size(); ++i) points[i].measured_on_frame = false;
 }
 
 void Frontend::addFrame(TimeNs t_ns, const cv::Mat& image) {

@@ -80,7 +80,11 @@ void FrameLagProbe::observe(const TrackPoints& points, std::size_t begin) {
       f.has_frame_position = true;
       f.frame_position = p.uv;
     }
-    if (f.n > 0 && p.t_ns <= f.t[1]) {  // a seed stamped at its detection frame: keep the newest
+    // The event track is made of event points alone: a point measured on a
+    // frame (the detection, the bootstrap) does not lag, and a line through
+    // it and a lagged point would not move at the track's speed.
+    if (p.measured_on_frame) continue;
+    if (f.n > 0 && p.t_ns <= f.t[1]) {  // two points at one time: keep the newest
       if (p.t_ns == f.t[1]) f.uv[1] = p.uv;
       continue;
     }

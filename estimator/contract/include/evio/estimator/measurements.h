@@ -52,10 +52,12 @@ struct TrackPoint {
   /// states it (its option error_time_s): the error of points Δt apart is
   /// correlated as e^(−Δt/τ). 0: independent from point to point.
   double error_time_s = 0.0;
-  /// The tracker measured this point on a frame, at the frame's time (EKLT's
-  /// detection and its bootstrap on the next frame), not from events: it
-  /// carries none of the event tracker's lag, so the synchroniser does not
-  /// compensate one.
+  /// An event tracker measured this point on a sensor frame, at the frame's
+  /// time, not from events (EKLT's detection and its bootstrap on the next
+  /// frame; not on images rebuilt from events, which lag as the events do):
+  /// it carries none of the event tracker's lag, so the synchroniser does
+  /// not compensate one. KLT, which tracks on frames alone, leaves it false:
+  /// its compensation (sync.track_latency_s, track_lag_px) is off unless set.
   bool measured_on_frame = false;
 };
 

@@ -86,7 +86,9 @@ class EkltTracker final : public FeatureTracker {
   /// Starts a feature by hand, bypassing detection and bootstrap: template
   /// from (gx, gy) of a log image around x0 (the position at the template
   /// frame), current position `uv` at time t_ns, rotation θ and flow angle φ.
-  /// Returns its id. For tests and for callers with their own detector.
+  /// Returns its id. For tests and for callers with their own detector. Its
+  /// one point (kNew at t_ns) is marked measured_on_frame: the caller's
+  /// position is taken as lag-free, as a detection is.
   FeatureId addFeature(const cv::Mat& log_image, const Vec2& x0, const Vec2& uv, TimeNs t_ns,
                        double flow_angle_rad, double theta_rad = 0.0);
 

@@ -116,6 +116,9 @@ class Frontend {
  private:
   /// points[begin, end) take the tracker's error time constant and stated σ.
   void stateNoise(TrackPoints& points, std::size_t begin) const;
+  /// With images rebuilt from events, the points the tracker measured on
+  /// them lag as the events do: points[begin, end) lose measured_on_frame.
+  void unmarkReconstructedFramePoints(TrackPoints& points, std::size_t begin) const;
 
   FrontendOptions options_;
   double error_time_s_ = 0.0;       ///< the tracker's options' error_time_s

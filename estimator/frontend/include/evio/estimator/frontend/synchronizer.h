@@ -29,10 +29,13 @@
 /// (track_latency_s τ, track_lag_px a: moved a px further along the motion
 /// and extrapolated τ later) is compensated only when that newest point came
 /// from events: a point measured on a frame (TrackPoint::measured_on_frame,
-/// EKLT's detection and bootstrap) does not lag. (Until the bootstrap leaves
-/// the velocity window, the velocity is fitted over points with and without
-/// the lag: on a line at speed |v| its slope is off by about
-/// (a + τ|v|) / span for the first event points.)
+/// EKLT's detection and bootstrap) does not lag. The velocity that moves the
+/// first event points is still taken over points with and without the lag
+/// until the bootstrap leaves it: on a line at speed |v| its slope is off by
+/// about (a + τ|v|) / (t1 − t0), t1 − t0 the time the fitted points span
+/// (velocity_window_s = 0: the gap from the bootstrap to the first event
+/// point, a few ms, so the first event point's extrapolation, and its τ|v|,
+/// can be well off).
 
 #include <cstdint>
 #include <deque>

@@ -221,12 +221,19 @@ TEST(Frontend, KltGyroPredictionTakesTheExtrinsicsAndTheImu) {
 // Every track point the frontend hands out states the error time constant
 // of the tracker that made it (its options section's error_time_s), and
 // only that tracker's: the other sections' values are not used.
-TEST(Frontend, TrackPointsStateTheirTrackersErrorTimeConstant) {
-  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+/// A 240 × 180 frame of 4 × 5 bright 16 px squares on a dark ground,
+/// blurred so that each corner has one strongest pixel (FAST's suppression).
+cv::Mat squaresImage() {
   cv::Mat image(180, 240, CV_8UC1, cv::Scalar(20));
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 5; ++c) image(cv::Rect(30 + 40 * c, 25 + 35 * r, 16, 16)).setTo(cv::Scalar(220));
-  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);  // corners with one strongest pixel (FAST's suppression)
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);
+  return image;
+}
+
+TEST(Frontend, TrackPointsStateTheirTrackersErrorTimeConstant) {
+  const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
+  const cv::Mat image = squaresImage();
   for (const std::string tracker : {"klt", "eklt"}) {
     FrontendOptions options;
     options.tracker = tracker;
@@ -248,10 +255,7 @@ TEST(Frontend, TrackPointsStateTheirTrackersErrorTimeConstant) {
 // as the events do, so the frontend leaves them unmarked.
 TEST(Frontend, EkltPointsAreMeasuredOnFramesOnlyOnSensorFrames) {
   const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
-  cv::Mat image(180, 240, CV_8UC1, cv::Scalar(20));
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 5; ++c) image(cv::Rect(30 + 40 * c, 25 + 35 * r, 16, 16)).setTo(cv::Scalar(220));
-  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);
+  const cv::Mat image = squaresImage();
   // Ten events at one corner pixel, away from the squares, from t0 on.
   const auto events = [](double t0) {
     EventArray ev;
@@ -285,10 +289,7 @@ TEST(Frontend, EkltPointsAreMeasuredOnFramesOnlyOnSensorFrames) {
 // EKLT keeps the covariance of its own fit whatever KLT's section says.
 TEST(Frontend, KltPointsStateTheirSectionsPositionSigma) {
   const Camera cam = Camera::create("pinhole", 240, 180, Vec4(200, 200, 120, 90), VecX());
-  cv::Mat image(180, 240, CV_8UC1, cv::Scalar(20));
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 5; ++c) image(cv::Rect(30 + 40 * c, 25 + 35 * r, 16, 16)).setTo(cv::Scalar(220));
-  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.5);
+  const cv::Mat image = squaresImage();
   const auto pointsOf = [&](const std::string& tracker, double klt_sigma_px) {
     FrontendOptions options;
     options.tracker = tracker;

@@ -19,6 +19,17 @@ TrackPoint point(FeatureId id, double t_s, Vec2 uv, TrackStatus status = TrackSt
 /// A track moving linearly: uv(t) = uv0 + v t.
 Vec2 linear(const Vec2& uv0, const Vec2& v, double t) { return uv0 + v * t; }
 
+/// Options that compensate a lag of τ (s) and a (px), an update every 10
+/// events, the velocity over the newest two points (window 0) or window_s.
+SynchronizerOptions lagOptions(double tau_s, double a_px, double window_s) {
+  SynchronizerOptions o;
+  o.n_e = 10;
+  o.track_latency_s = tau_s;
+  o.track_lag_px = a_px;
+  o.velocity_window_s = window_s;
+  return o;
+}
+
 TEST(Synchronizer, EveryNeEventsExtrapolatesLinearlyToTheLatestTrackTime) {
   SynchronizerOptions o;
   o.n_e = 100;
@@ -153,11 +164,7 @@ TEST(Synchronizer, CompensatesALagInDistanceAndTimeAtAnySpeed) {
   // points here) is the same on a line; the set comes at 15 ms, 1 ms after
   // the slow track's newest point (extrapolated) and at the fast one's.
   for (const double window : {0.0, 0.02}) {
-    SynchronizerOptions o;
-    o.n_e = 10;
-    o.track_latency_s = tau;
-    o.track_lag_px = a;
-    o.velocity_window_s = window;
+    const SynchronizerOptions o = lagOptions(tau, a, window);
     SynchronizerOptions distance_only = o;
     distance_only.track_latency_s = 0.0;
     Synchronizer sync(o), partial(distance_only);
@@ -211,12 +218,7 @@ TEST(Synchronizer, CompensatesNoLagForPointsMeasuredOnFrames) {
     return point(id, t, linear(uv0, v, t - tau) - a * v.normalized());
   };
   for (const double window : {0.0, 0.02}) {
-    SynchronizerOptions o;
-    o.n_e = 10;
-    o.track_latency_s = tau;
-    o.track_lag_px = a;
-    o.velocity_window_s = window;
-    Synchronizer sync(o);
+    Synchronizer sync(lagOptions(tau, a, window));
     sync.addTrackPoints({onFrame(7, 0.000, TrackStatus::kNew), onFrame(9, 0.000, TrackStatus::kNew),
                          onFrame(7, 0.046, TrackStatus::kTracked), lagged(9, 0.046),
                          onFrame(9, 0.046, TrackStatus::kTracked), lagged(8, 0.030), lagged(8, 0.048)});

@@ -97,12 +97,18 @@ class MovingTexture {
   cv::Mat texture_;
 };
 
-TEST(FrameLagProbe, RecoversAKnownLagFromFramesAndEventTracks) {
-  const double a = 0.4, tau = 0.0015;
-  const MovingTexture scene;
+/// Twelve feature seeds on a 4 × 3 grid inside the 240 × 180 frame, px.
+std::vector<Vec2> seedGrid() {
   std::vector<Vec2> seeds;
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 3; ++j) seeds.emplace_back(40.0 + 30.0 * i, 40.0 + 25.0 * j);
+  return seeds;
+}
+
+TEST(FrameLagProbe, RecoversAKnownLagFromFramesAndEventTracks) {
+  const double a = 0.4, tau = 0.0015;
+  const MovingTexture scene;
+  const std::vector<Vec2> seeds = seedGrid();
   TrackLagOptions o;
   o.estimate = true;
   o.min_samples = 10;
@@ -149,9 +155,7 @@ TEST(FrameLagProbe, RecoversAKnownLagFromFramesAndEventTracks) {
 TEST(FrameLagProbe, TakesNoSampleThroughAPointMeasuredOnAFrame) {
   const double a = 0.4, tau = 0.0015;
   const MovingTexture scene;
-  std::vector<Vec2> seeds;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 3; ++j) seeds.emplace_back(40.0 + 30.0 * i, 40.0 + 25.0 * j);
+  const std::vector<Vec2> seeds = seedGrid();
   const auto truth = [&](std::size_t i, double t) { return Vec2(seeds[i] + MovingTexture::offset(t)); };
   const auto points = [&](double t, TrackStatus status, bool on_frame) {
     TrackPoints out;

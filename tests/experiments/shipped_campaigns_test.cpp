@@ -134,9 +134,11 @@ void flatten(const YAML::Node& node, const std::string& prefix, std::map<std::st
   for (const auto& kv : node) flatten(kv.second, (prefix.empty() ? "" : prefix + ".") + kv.first.as<std::string>(), out);
 }
 
-TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButThreeSettingsOfEkltAndTwoOfKlt) {
-  // estimator/config/sim_mars.yaml says it is sim.yaml with three settings of
-  // EKLT changed (its error time constant, 54 ms on the Mars rigs and 42 ms
+TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFourSettingsOfEkltAndTwoOfKlt) {
+  // estimator/config/sim_mars.yaml says it is sim.yaml with four settings of
+  // EKLT changed (its Harris level, 0.01 over the Mars terrain where one
+  // bright rock sets the strongest corner: "The corners EKLT starts"; its
+  // error time constant, 54 ms on the Mars rigs and 42 ms
   // indoors, each measured by one rule: docs/consistency.md "Correlated
   // errors: the options side by side", "The options measured again on
   // today's defaults"; "A covariance floor that follows the fit", "A minimum quality from
@@ -154,6 +156,7 @@ TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButThreeSettingsOfEkltAndTwoOfK
   for (const auto& [key, value] : indoor)
     if (mars.count(key) == 0) differ[key] = "(missing)";
   EXPECT_EQ(differ, (std::map<std::string, std::string>{{"frontend.eklt.error_time_s", "0.054"},
+                                                        {"frontend.eklt.harris_quality_level", "0.01"},
                                                         {"frontend.eklt.position_sigma_cost_ref", "0.33"},
                                                         {"frontend.eklt.min_tracking_quality", "0.6"},
                                                         {"frontend.klt.backward_check_px", "1"},

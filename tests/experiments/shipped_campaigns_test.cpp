@@ -134,10 +134,11 @@ void flatten(const YAML::Node& node, const std::string& prefix, std::map<std::st
   for (const auto& kv : node) flatten(kv.second, (prefix.empty() ? "" : prefix + ".") + kv.first.as<std::string>(), out);
 }
 
-TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFourSettingsOfEkltAndTwoOfKlt) {
-  // estimator/config/sim_mars.yaml says it is sim.yaml with four settings of
+TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFiveSettingsOfEkltAndTwoOfKlt) {
+  // estimator/config/sim_mars.yaml says it is sim.yaml with five settings of
   // EKLT changed (its Harris level, 0.01 over the Mars terrain where one
-  // bright rock sets the strongest corner: "The corners EKLT starts"; its
+  // bright rock sets the strongest corner, and its σ floor, 1.2 px: "The
+  // corners EKLT starts"; its
   // error time constant, 54 ms on the Mars rigs and 42 ms
   // indoors, each measured by one rule: docs/consistency.md "Correlated
   // errors: the options side by side", "The options measured again on
@@ -159,6 +160,7 @@ TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFourSettingsOfEkltAndTwoOfKl
                                                         {"frontend.eklt.harris_quality_level", "0.01"},
                                                         {"frontend.eklt.position_sigma_cost_ref", "0.33"},
                                                         {"frontend.eklt.min_tracking_quality", "0.6"},
+                                                        {"frontend.eklt.position_sigma_min_px", "1.2"},
                                                         {"frontend.klt.backward_check_px", "1"},
                                                         {"frontend.klt.position_sigma_px", "2.5"}}));
 }

@@ -138,9 +138,8 @@ TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFiveSettingsOfEkltAndTwoOfKl
   // estimator/config/sim_mars.yaml says it is sim.yaml with five settings of
   // EKLT changed (its Harris level, 0.01 over the Mars terrain where one
   // bright rock sets the strongest corner, and its σ floor, 1.2 px: "The
-  // corners EKLT starts"; its
-  // error time constant, 54 ms on the Mars rigs and 42 ms
-  // indoors, each measured by one rule: docs/consistency.md "Correlated
+  // corners EKLT starts"; its error time constant, 54 ms on the Mars rigs
+  // and 42 ms indoors, each measured by one rule: docs/consistency.md "Correlated
   // errors: the options side by side", "The options measured again on
   // today's defaults"; "A covariance floor that follows the fit", "A minimum quality from
   // the measured errors"), KLT's forward-backward check on ("KLT-VIO: iterated

@@ -11,6 +11,7 @@
 #include "evio/core/stopwatch.h"
 #include "evio/estimator/frontend/feature_detection.h"
 #include "evio/estimator/frontend/log_image.h"
+#include "evio/estimator/frontend/track_velocity.h"
 
 namespace evio::estimator {
 
@@ -60,6 +61,8 @@ void EkltOptions::validate() const {
   requireField(bootstrap_window_px >= 3 && bootstrap_window_px <= 255, "bootstrap_window_px", "must be in [3, 255]");
   requireField(bootstrap_pyramid_levels >= 1 && bootstrap_pyramid_levels <= 16, "bootstrap_pyramid_levels",
                "must be in [1, 16]");
+  requireInRange("imu_prediction_min_shift_px", imu_prediction_min_shift_px, 0.0, 1000.0);
+  requireInRange("imu_prediction_translation_window_s", imu_prediction_translation_window_s, 0.0, 10.0);
   requirePositive("log_offset", log_offset);
 }
 
@@ -83,6 +86,10 @@ struct EkltTracker::Slot {
   TimeNs t_last_ns = 0;
   double quality = 1.0;
   PixelRect rect;              // where the grid has this slot's bit
+  /// imu_prediction_translation_window_s: the sum of the accepted steps less
+  /// the gyro's rotation over each (px), and its fitted velocity (px/s).
+  Vec2 derotated_path = Vec2::Zero();
+  TrackVelocity translation;
 };
 
 /// One part of the feature partition (eklt_tracker.h): slots s with
@@ -179,6 +186,9 @@ void EkltTracker::activate(int index, const Vec2& uv, TimeNs t_ns, double flow_a
   s.t_centre_ns = t_ns;
   s.flow_angle = wrapAngle(flow_angle);
   s.quality = 1.0;
+  s.derotated_path = Vec2::Zero();
+  s.translation = TrackVelocity(options_.imu_prediction_translation_window_s);
+  s.translation.add(t_ns, s.derotated_path);
   resetPatch(s);
   // Initial batch size from the template seen along the initial flow.
   Part& part = partOf(index);
@@ -367,6 +377,18 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
   return sol;
 }
 
+Vec2 EkltTracker::predictedCentre(const Slot& s, TimeNs t) const {
+  if (!predictor_ || predictor_->empty()) return s.centre;
+  const std::optional<Vec2> rotated = predictor_->predict(s.centre, s.t_centre_ns, t);
+  if (!rotated) return s.centre;
+  Vec2 uv = *rotated;
+  if (options_.imu_prediction_translation_window_s > 0.0) {
+    if (const std::optional<Vec2> v = s.translation.velocity()) uv += *v * nsToSeconds(t - s.t_centre_ns);
+  }
+  if ((uv - s.centre).norm() < options_.imu_prediction_min_shift_px) return s.centre;
+  return uv;
+}
+
 void EkltTracker::mergeChunkPoints() { estimator::mergeChunkPoints(part_points_, out_); }
 
 void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
@@ -386,10 +408,7 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
 
   // Initial guess: the previous warp, with the centre moved to the gyro
   // prediction when enabled: t = x0 − R(θ)(c_pred − c).
-  Vec2 predicted = s.centre;
-  if (predictor_ && !predictor_->empty()) {
-    if (auto uv = predictor_->predict(s.centre, s.t_centre_ns, t_mid)) predicted = *uv;
-  }
+  const Vec2 predicted = predictedCentre(s, t_mid);
   const double c = std::cos(s.theta);
   const double sn = std::sin(s.theta);
   const Vec2 d = predicted - s.centre;
@@ -411,6 +430,11 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
     lose(part, index, event_index);
     part.timing.optimisation_s += start.seconds();
     return;
+  }
+  if (predictor_ && options_.imu_prediction_translation_window_s > 0.0) {
+    const Vec2 rotated = predictor_->predict(s.centre, s.t_centre_ns, t_mid).value_or(s.centre);
+    s.derotated_path += uv - rotated;
+    s.translation.add(t_mid, s.derotated_path);
   }
   s.theta = sol.p[0];
   s.flow_angle = wrapAngle(sol.p[3]);

@@ -125,6 +125,23 @@ struct EkltOptions {
 
   // Prediction and images.
   bool imu_prediction = false;         ///< predict each batch's start from the gyro (needs IMU and T_B_C)
+  /// Use the gyro's prediction for a batch only when it moves the feature at
+  /// least this far from its last position, px (0: on every batch). A batch
+  /// is sized for batch_displacement_px of motion; a feature the gyro moves
+  /// much farther between batches is one whose pixels fire fewer events per
+  /// edge than the size assumed (fast motion, the refractory period), where
+  /// a start at the last position is pixels behind. Below the gate the batch
+  /// starts, and its plausibility window is centred, at the last position.
+  double imu_prediction_min_shift_px = 0.0;
+  /// With imu_prediction, add each feature's own translational image
+  /// velocity to the gyro's rotation, s (0: rotation only). The gyro
+  /// explains the image motion of a camera that only turns; what a track
+  /// moves beyond it is the translation's flow, which changes with the
+  /// feature's depth. It is the least-squares slope over the feature's last
+  /// points within this window of its derotated path: the sum of each
+  /// accepted step minus the gyro's rotation over that step
+  /// (track_velocity.h).
+  double imu_prediction_translation_window_s = 0.0;
   double log_offset = 0.01;            ///< L = log(I/255 + offset) for 8-bit frames
 
   template <class V>
@@ -157,6 +174,10 @@ struct EkltOptions {
     v("bootstrap_window_px", bootstrap_window_px, "bootstrap KLT window, px");
     v("bootstrap_pyramid_levels", bootstrap_pyramid_levels, "bootstrap KLT pyramid levels");
     v("imu_prediction", imu_prediction, "predict feature positions from the gyro");
+    v("imu_prediction_min_shift_px", imu_prediction_min_shift_px,
+      "use the gyro prediction only when it moves the feature this far, px (0: always)");
+    v("imu_prediction_translation_window_s", imu_prediction_translation_window_s,
+      "add the feature's translational velocity fitted over this window to the gyro prediction, s (0: rotation only)");
     v("log_offset", log_offset, "offset in log(I/255 + offset)");
   }
 

@@ -115,6 +115,12 @@ class EkltTracker final : public FeatureTracker {
   void trackInParts(const EventArray& events, std::size_t begin, std::size_t end);
   void mergeChunkPoints();
   void optimise(Part& part, int slot_index, std::size_t event_index);
+  /// Where the feature of slot `s` is expected at time t: its last position
+  /// moved by the gyro's rotation since (imu_prediction) and, with
+  /// imu_prediction_translation_window_s, by its translational velocity
+  /// times the time since; or the last position itself (no prediction, or
+  /// one shorter than imu_prediction_min_shift_px).
+  Vec2 predictedCentre(const Slot& s, TimeNs t) const;
   /// The batch's solution from p0, re-solved from the reversed flow when
   /// implausible (EkltOptions::reversal_quality, max_batch_shift_px);
   /// nullopt when neither moves the feature plausibly (an invalid solution

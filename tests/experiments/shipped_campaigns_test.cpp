@@ -134,9 +134,10 @@ void flatten(const YAML::Node& node, const std::string& prefix, std::map<std::st
   for (const auto& kv : node) flatten(kv.second, (prefix.empty() ? "" : prefix + ".") + kv.first.as<std::string>(), out);
 }
 
-TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFiveSettingsOfEkltAndTwoOfKlt) {
-  // estimator/config/sim_mars.yaml says it is sim.yaml with five settings of
-  // EKLT changed (its Harris level, 0.01 over the Mars terrain where one
+TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButSevenSettingsOfEkltAndTwoOfKlt) {
+  // estimator/config/sim_mars.yaml says it is sim.yaml with seven settings of
+  // EKLT changed (the gyro prediction with the translation's flow, indoors
+  // only: "The prediction with the translation's flow"; its Harris level, 0.01 over the Mars terrain where one
   // bright rock sets the strongest corner, and its σ floor, 1.2 px: "The
   // corners EKLT starts"; its error time constant, 54 ms on the Mars rigs
   // and 42 ms indoors, each measured by one rule: docs/consistency.md "Correlated
@@ -156,6 +157,8 @@ TEST(ShippedConfigs, TheMarsRigsSetIsTheIndoorSetButFiveSettingsOfEkltAndTwoOfKl
   for (const auto& [key, value] : indoor)
     if (mars.count(key) == 0) differ[key] = "(missing)";
   EXPECT_EQ(differ, (std::map<std::string, std::string>{{"frontend.eklt.error_time_s", "0.054"},
+                                                        {"frontend.eklt.imu_prediction", "(missing)"},
+                                                        {"frontend.eklt.imu_prediction_translation_window_s", "(missing)"},
                                                         {"frontend.eklt.harris_quality_level", "0.01"},
                                                         {"frontend.eklt.position_sigma_cost_ref", "0.33"},
                                                         {"frontend.eklt.min_tracking_quality", "0.6"},

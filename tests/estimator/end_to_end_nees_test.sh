@@ -6,7 +6,7 @@
 # runs of their average 6-dof pose NEES) must lie inside the two-sided 95 %
 # χ² bounds for 20 runs, [χ²_0.025(120), χ²_0.975(120)] / 20 = [4.58, 7.61].
 # Both bounds: a filter that claims too much (ANEES above) or too little
-# (below) fails. Measured at 5.14 (EKLT-VIO, session 51) and 4.68 (KLT-VIO).
+# (below) fails. Measured at 5.25 (EKLT-VIO, session 58; 5.14 in session 51) and 4.68 (KLT-VIO).
 #
 # usage: end_to_end_nees_test.sh <evio> <campaign.yaml> <work-folder>
 set -euo pipefail

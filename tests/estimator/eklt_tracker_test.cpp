@@ -289,69 +289,66 @@ TEST(EkltTracker, DetectsBootstrapsAndTracksFromFrames) {
   EXPECT_GE(tracker.numAlive(), 4u);
 }
 
-// Gyro prediction: the camera rolls about its optical axis at ω_z, so the
-// image turns about the principal point by −ω_z t. With the prediction the
-// optimiser starts nearer the solution and needs fewer iterations, and the
-// track stays as accurate.
-TEST(EkltTracker, GyroPredictionSavesIterationsUnderRotation) {
-  const BlobTexture tex = BlobTexture::random(13, kWidth, kHeight, 400);
-  const double omega_z = 0.8;
-  RigidMotion m;
-  m.omega_rad_s = -omega_z;
-  m.centre = Vec2(59.5, 49.5);  // the principal point of testCamera()
-  const Vec2 x0 = nearestCorner(tex, m, Vec2(90, 45));
-  std::vector<Vec2> path;
-  for (int k = 0; k <= 20; ++k) path.push_back(m.forward(x0, 0.5 * k / 20.0));
-  const EventArray events = test::generateEvents(tex, m, roiAround(path, 13), 0.0, 0.5, 1e-3, kContrast);
-  double iterations[2] = {0, 0};
-  double mean_err[2] = {0, 0};
-  for (int with_prediction = 0; with_prediction < 2; ++with_prediction) {
-    EkltOptions options;
-    options.batch_contrast_threshold = kContrast;
-    options.batch_max_events = 5000;
-    options.imu_prediction = with_prediction == 1;
-    EkltTracker tracker(options, testCamera(), Pose());  // T_B_C = identity
-    for (int k = 0; k <= 500; ++k) tracker.addImu(ImuSample{secondsToNs(k * 1e-3), Vec3::Zero(), Vec3(0, 0, omega_z)});
-    const Vec2 flow = m.forward(x0, 0.01) - x0;
-    tracker.addFeature(test::renderLog(tex, m, 0.0, kWidth, kHeight), x0, x0, 0, std::atan2(flow.y(), flow.x()));
-    tracker.addEvents(events);
-    TrackPoints points;
-    tracker.drainTrackPoints(points);
-    ASSERT_GT(points.size(), 10u);
-    EXPECT_NE(points.back().status, TrackStatus::kLost);
-    for (const TrackPoint& p : points) mean_err[with_prediction] += (p.uv - m.forward(x0, nsToSeconds(p.t_ns))).norm();
-    mean_err[with_prediction] /= static_cast<double>(points.size());
-    iterations[with_prediction] =
-        static_cast<double>(tracker.timing().solver_iterations) / static_cast<double>(tracker.timing().optimisations);
-  }
-  EXPECT_LT(iterations[1], iterations[0]);
-  EXPECT_LT(mean_err[1], 0.25);
-  EXPECT_LT(mean_err[1], mean_err[0] + 0.02);
-  RecordProperty("iterations_without", std::to_string(iterations[0]));
-  RecordProperty("iterations_with", std::to_string(iterations[1]));
-}
+/// One feature tracked through 0.5 s of the motion m by a tracker whose gyro
+/// reads `gyro` (rad/s; the body frame is the camera's), started at x0 with
+/// the flow angle of m's first 10 ms. Batches up to 5000 events (C = 0.01).
+struct GyroRun {
+  TrackPoints points;
+  double iterations_per_batch = 0.0;
+  double mean_error_px = 0.0;  ///< against m's exact path
+};
 
-/// One feature's track while the camera rolls about its optical axis at
-/// omega_z (rad/s) for 0.5 s: the image turns about the principal point by
-/// −omega_z t, and the gyro reads omega_z about the camera's z.
-TrackPoints trackUnderRoll(EkltOptions options, double omega_z) {
-  const BlobTexture tex = BlobTexture::random(13, kWidth, kHeight, 400);
-  RigidMotion m;
-  m.omega_rad_s = -omega_z;
-  m.centre = Vec2(59.5, 49.5);  // the principal point of testCamera()
-  const Vec2 x0 = nearestCorner(tex, m, Vec2(90, 45));
+GyroRun trackWithGyro(EkltOptions options, const BlobTexture& tex, const RigidMotion& m, const Vec2& x0,
+                      const Vec3& gyro) {
   std::vector<Vec2> path;
   for (int k = 0; k <= 20; ++k) path.push_back(m.forward(x0, 0.5 * k / 20.0));
   const EventArray events = test::generateEvents(tex, m, roiAround(path, 13), 0.0, 0.5, 1e-3, kContrast);
   options.batch_max_events = 5000;
   EkltTracker tracker(options, testCamera(), Pose());  // T_B_C = identity
-  for (int k = 0; k <= 500; ++k) tracker.addImu(ImuSample{secondsToNs(k * 1e-3), Vec3::Zero(), Vec3(0, 0, omega_z)});
+  for (int k = 0; k <= 500; ++k) tracker.addImu(ImuSample{secondsToNs(k * 1e-3), Vec3::Zero(), gyro});
   const Vec2 flow = m.forward(x0, 0.01) - x0;
   tracker.addFeature(test::renderLog(tex, m, 0.0, kWidth, kHeight), x0, x0, 0, std::atan2(flow.y(), flow.x()));
   tracker.addEvents(events);
-  TrackPoints points;
-  tracker.drainTrackPoints(points);
-  return points;
+  GyroRun run;
+  tracker.drainTrackPoints(run.points);
+  for (const TrackPoint& p : run.points) run.mean_error_px += (p.uv - m.forward(x0, nsToSeconds(p.t_ns))).norm();
+  if (!run.points.empty()) run.mean_error_px /= static_cast<double>(run.points.size());
+  run.iterations_per_batch =
+      static_cast<double>(tracker.timing().solver_iterations) / static_cast<double>(tracker.timing().optimisations);
+  return run;
+}
+
+/// The camera rolls about its optical axis at omega_z (rad/s): the image
+/// turns about the principal point by −omega_z t.
+RigidMotion roll(double omega_z) {
+  RigidMotion m;
+  m.omega_rad_s = -omega_z;
+  m.centre = Vec2(59.5, 49.5);  // the principal point of testCamera()
+  return m;
+}
+
+// Gyro prediction under a roll at 0.8 rad/s: with the prediction the
+// optimiser starts nearer the solution and needs fewer iterations, and the
+// track stays as accurate.
+TEST(EkltTracker, GyroPredictionSavesIterationsUnderRotation) {
+  const BlobTexture tex = BlobTexture::random(13, kWidth, kHeight, 400);
+  const double omega_z = 0.8;
+  const RigidMotion m = roll(omega_z);
+  const Vec2 x0 = nearestCorner(tex, m, Vec2(90, 45));
+  GyroRun runs[2];
+  for (int with_prediction = 0; with_prediction < 2; ++with_prediction) {
+    EkltOptions options;
+    options.batch_contrast_threshold = kContrast;
+    options.imu_prediction = with_prediction == 1;
+    runs[with_prediction] = trackWithGyro(options, tex, m, x0, Vec3(0, 0, omega_z));
+    ASSERT_GT(runs[with_prediction].points.size(), 10u);
+    EXPECT_NE(runs[with_prediction].points.back().status, TrackStatus::kLost);
+  }
+  EXPECT_LT(runs[1].iterations_per_batch, runs[0].iterations_per_batch);
+  EXPECT_LT(runs[1].mean_error_px, 0.25);
+  EXPECT_LT(runs[1].mean_error_px, runs[0].mean_error_px + 0.02);
+  RecordProperty("iterations_without", std::to_string(runs[0].iterations_per_batch));
+  RecordProperty("iterations_with", std::to_string(runs[1].iterations_per_batch));
 }
 
 bool samePoints(const TrackPoints& a, const TrackPoints& b) {
@@ -369,15 +366,19 @@ double largestStep(const TrackPoints& points) {
 }
 
 // The prediction's gate (imu_prediction_min_shift_px) decides batch by
-// batch. Batches sized for the events' contrast move the feature about
-// batch_displacement_px (0.6 px) each, under a 1.5 px gate: the track is
-// the unpredicted one, point for point. Batches sized for a sixth of the
-// events' contrast expect six times the events per pixel of motion and so
-// span six times the motion (about 3.5 px, as when a pixel fires fewer
-// events per edge than the size assumes): every prediction passes the gate
-// and the track is the always-predicted one.
+// batch, under a roll at 0.8 rad/s. Batches sized for the events' contrast
+// move the feature about batch_displacement_px (0.6 px) each, under a
+// 1.5 px gate: the track is the unpredicted one, point for point. Batches
+// sized for a sixth of the events' contrast expect six times the events
+// per pixel of motion and so span six times the motion (about 3.5 px, as
+// when a pixel fires fewer events per edge than the size assumes): every
+// prediction passes the gate and the track is the always-predicted one.
 TEST(EkltTracker, GyroPredictionGateDecidesBatchByBatch) {
+  const BlobTexture tex = BlobTexture::random(13, kWidth, kHeight, 400);
   const double omega_z = 0.8;
+  const RigidMotion m = roll(omega_z);
+  const Vec2 x0 = nearestCorner(tex, m, Vec2(90, 45));
+  const auto track = [&](const EkltOptions& o) { return trackWithGyro(o, tex, m, x0, Vec3(0, 0, omega_z)).points; };
   EkltOptions off;
   off.batch_contrast_threshold = kContrast;
   EkltOptions always = off;
@@ -385,64 +386,49 @@ TEST(EkltTracker, GyroPredictionGateDecidesBatchByBatch) {
   EkltOptions gated = always;
   gated.imu_prediction_min_shift_px = 1.5;
 
-  const TrackPoints slow_off = trackUnderRoll(off, omega_z);
-  const TrackPoints slow_always = trackUnderRoll(always, omega_z);
+  const TrackPoints slow_off = track(off);
   ASSERT_GT(slow_off.size(), 10u);
   EXPECT_LT(largestStep(slow_off), 1.0);
-  EXPECT_FALSE(samePoints(slow_off, slow_always));  // the prediction changes the track
-  EXPECT_TRUE(samePoints(trackUnderRoll(gated, omega_z), slow_off));
+  EXPECT_FALSE(samePoints(slow_off, track(always)));  // the prediction changes the track
+  EXPECT_TRUE(samePoints(track(gated), slow_off));
 
   for (EkltOptions* o : {&off, &always, &gated}) o->batch_contrast_threshold = kContrast / 6.0;
-  const TrackPoints coarse_always = trackUnderRoll(always, omega_z);
+  const TrackPoints coarse_always = track(always);
   ASSERT_GT(coarse_always.size(), 4u);
   EXPECT_GT(largestStep(coarse_always), 2.0);
-  EXPECT_TRUE(samePoints(trackUnderRoll(gated, omega_z), coarse_always));
-  EXPECT_FALSE(samePoints(trackUnderRoll(off, omega_z), coarse_always));
+  EXPECT_TRUE(samePoints(track(gated), coarse_always));
+  EXPECT_FALSE(samePoints(track(off), coarse_always));
 }
 
 // The translation's part of the prediction: a patch translating at 40 px/s
-// while the gyro reads zero, in batches sized for a quarter of the events'
-// contrast (so each spans about 2.4 px). The gyro alone predicts no motion,
-// so each batch starts where the last one ended, 2.4 px behind; with the
-// feature's own translational velocity (fitted over 20 ms of its derotated
-// path) it starts near its solution: fewer solver iterations (measured 3.9
-// and 2.1 per batch), the track as accurate (within 0.02 px of the mean
-// error, and under 0.1 px).
+// at 30° while the gyro reads zero, in batches sized for a quarter of the
+// events' contrast (so each spans about 2.4 px). The gyro alone predicts
+// no motion, so each batch starts where the last one ended, 2.4 px behind;
+// with the feature's own translational velocity (fitted over 20 ms of its
+// derotated path) it starts near its solution: fewer solver iterations
+// (measured 3.9 and 2.1 per batch), the track as accurate (within 0.02 px
+// of the mean error, and under 0.1 px).
 TEST(EkltTracker, TranslationalVelocityInThePredictionSavesIterations) {
   const BlobTexture tex = BlobTexture::random(3, kWidth, kHeight, 400);
   const double angle = 30.0 * M_PI / 180.0;
   RigidMotion m;
   m.velocity_px_s = 40.0 * Vec2(std::cos(angle), std::sin(angle));
   const Vec2 x0 = nearestCorner(tex, m, Vec2(40, 30));
-  std::vector<Vec2> path;
-  for (int k = 0; k <= 20; ++k) path.push_back(m.forward(x0, 0.5 * k / 20.0));
-  const EventArray events = test::generateEvents(tex, m, roiAround(path, 13), 0.0, 0.5, 1e-3, kContrast);
-  double iterations[2] = {0, 0};
-  double mean_err[2] = {0, 0};
+  GyroRun runs[2];
   for (int with_translation = 0; with_translation < 2; ++with_translation) {
     EkltOptions options;
     options.batch_contrast_threshold = kContrast / 4.0;
-    options.batch_max_events = 5000;
     options.imu_prediction = true;
     options.imu_prediction_translation_window_s = with_translation == 1 ? 0.02 : 0.0;
-    EkltTracker tracker(options, testCamera(), Pose());
-    for (int k = 0; k <= 500; ++k) tracker.addImu(ImuSample{secondsToNs(k * 1e-3), Vec3::Zero(), Vec3::Zero()});
-    tracker.addFeature(test::renderLog(tex, m, 0.0, kWidth, kHeight), x0, x0, 0, angle);
-    tracker.addEvents(events);
-    TrackPoints points;
-    tracker.drainTrackPoints(points);
-    ASSERT_GT(points.size(), 8u);
-    EXPECT_NE(points.back().status, TrackStatus::kLost);
-    for (const TrackPoint& p : points) mean_err[with_translation] += (p.uv - m.forward(x0, nsToSeconds(p.t_ns))).norm();
-    mean_err[with_translation] /= static_cast<double>(points.size());
-    iterations[with_translation] =
-        static_cast<double>(tracker.timing().solver_iterations) / static_cast<double>(tracker.timing().optimisations);
+    runs[with_translation] = trackWithGyro(options, tex, m, x0, Vec3::Zero());
+    ASSERT_GT(runs[with_translation].points.size(), 8u);
+    EXPECT_NE(runs[with_translation].points.back().status, TrackStatus::kLost);
   }
-  EXPECT_LT(iterations[1], iterations[0]);
-  EXPECT_LT(mean_err[1], 0.1);
-  EXPECT_LT(mean_err[1], mean_err[0] + 0.02);
-  RecordProperty("iterations_without", std::to_string(iterations[0]));
-  RecordProperty("iterations_with", std::to_string(iterations[1]));
+  EXPECT_LT(runs[1].iterations_per_batch, runs[0].iterations_per_batch);
+  EXPECT_LT(runs[1].mean_error_px, 0.1);
+  EXPECT_LT(runs[1].mean_error_px, runs[0].mean_error_px + 0.02);
+  RecordProperty("iterations_without", std::to_string(runs[0].iterations_per_batch));
+  RecordProperty("iterations_with", std::to_string(runs[1].iterations_per_batch));
 }
 
 }  // namespace

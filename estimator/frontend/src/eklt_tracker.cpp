@@ -62,7 +62,7 @@ void EkltOptions::validate() const {
   requireField(bootstrap_pyramid_levels >= 1 && bootstrap_pyramid_levels <= 16, "bootstrap_pyramid_levels",
                "must be in [1, 16]");
   requireInRange("imu_prediction_min_shift_px", imu_prediction_min_shift_px, 0.0, 1000.0);
-  requireInRange("imu_prediction_translation_window_s", imu_prediction_translation_window_s, 0.0, 10.0);
+  requireInRange("imu_prediction_translation_window_s", imu_prediction_translation_window_s, 0.0, 1.0);
   requirePositive("log_offset", log_offset);
 }
 
@@ -389,6 +389,13 @@ Vec2 EkltTracker::predictedCentre(const Slot& s, TimeNs t) const {
   return uv;
 }
 
+void EkltTracker::addDerotatedStep(Slot& s, const Vec2& uv, TimeNs t) const {
+  if (!predictor_ || !(options_.imu_prediction_translation_window_s > 0.0)) return;
+  const Vec2 rotated = predictor_->predict(s.centre, s.t_centre_ns, t).value_or(s.centre);
+  s.derotated_path += uv - rotated;
+  s.translation.add(t, s.derotated_path);
+}
+
 void EkltTracker::mergeChunkPoints() { estimator::mergeChunkPoints(part_points_, out_); }
 
 void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
@@ -431,11 +438,7 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
     part.timing.optimisation_s += start.seconds();
     return;
   }
-  if (predictor_ && options_.imu_prediction_translation_window_s > 0.0) {
-    const Vec2 rotated = predictor_->predict(s.centre, s.t_centre_ns, t_mid).value_or(s.centre);
-    s.derotated_path += uv - rotated;
-    s.translation.add(t_mid, s.derotated_path);
-  }
+  addDerotatedStep(s, uv, t_mid);
   s.theta = sol.p[0];
   s.flow_angle = wrapAngle(sol.p[3]);
   s.quality = sol.quality();

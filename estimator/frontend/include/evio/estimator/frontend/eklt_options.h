@@ -140,7 +140,7 @@ struct EkltOptions {
   /// feature's depth. It is the least-squares slope over the feature's last
   /// points within this window of its derotated path: the sum of each
   /// accepted step minus the gyro's rotation over that step
-  /// (track_velocity.h).
+  /// (track_velocity.h). At most 1 s.
   double imu_prediction_translation_window_s = 0.0;
   double log_offset = 0.01;            ///< L = log(I/255 + offset) for 8-bit frames
 

@@ -121,6 +121,10 @@ class EkltTracker final : public FeatureTracker {
   /// times the time since; or the last position itself (no prediction, or
   /// one shorter than imu_prediction_min_shift_px).
   Vec2 predictedCentre(const Slot& s, TimeNs t) const;
+  /// With imu_prediction_translation_window_s: the feature of slot `s`,
+  /// still at its last position, is accepted at uv at time t; its derotated
+  /// path grows by the step less the gyro's rotation over it.
+  void addDerotatedStep(Slot& s, const Vec2& uv, TimeNs t) const;
   /// The batch's solution from p0, re-solved from the reversed flow when
   /// implausible (EkltOptions::reversal_quality, max_batch_shift_px);
   /// nullopt when neither moves the feature plausibly (an invalid solution

@@ -377,9 +377,12 @@ std::optional<EkltSolution> EkltTracker::solveBatch(const Slot& s, const EkltBat
   return sol;
 }
 
-Vec2 EkltTracker::predictedCentre(const Slot& s, TimeNs t) const {
-  if (!predictor_ || predictor_->empty()) return s.centre;
-  const std::optional<Vec2> rotated = predictor_->predict(s.centre, s.t_centre_ns, t);
+std::optional<Vec2> EkltTracker::rotatedCentre(const Slot& s, TimeNs t) const {
+  if (!predictor_ || predictor_->empty()) return std::nullopt;
+  return predictor_->predict(s.centre, s.t_centre_ns, t);
+}
+
+Vec2 EkltTracker::predictedCentre(const Slot& s, const std::optional<Vec2>& rotated, TimeNs t) const {
   if (!rotated) return s.centre;
   Vec2 uv = *rotated;
   if (options_.imu_prediction_translation_window_s > 0.0) {
@@ -389,10 +392,9 @@ Vec2 EkltTracker::predictedCentre(const Slot& s, TimeNs t) const {
   return uv;
 }
 
-void EkltTracker::addDerotatedStep(Slot& s, const Vec2& uv, TimeNs t) const {
+void EkltTracker::addDerotatedStep(Slot& s, const Vec2& uv, const std::optional<Vec2>& rotated, TimeNs t) const {
   if (!predictor_ || !(options_.imu_prediction_translation_window_s > 0.0)) return;
-  const Vec2 rotated = predictor_->predict(s.centre, s.t_centre_ns, t).value_or(s.centre);
-  s.derotated_path += uv - rotated;
+  s.derotated_path += uv - rotated.value_or(s.centre);
   s.translation.add(t, s.derotated_path);
 }
 
@@ -415,7 +417,8 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
 
   // Initial guess: the previous warp, with the centre moved to the gyro
   // prediction when enabled: t = x0 − R(θ)(c_pred − c).
-  const Vec2 predicted = predictedCentre(s, t_mid);
+  const std::optional<Vec2> rotated = rotatedCentre(s, t_mid);  // once per batch: the start and the derotated step
+  const Vec2 predicted = predictedCentre(s, rotated, t_mid);
   const double c = std::cos(s.theta);
   const double sn = std::sin(s.theta);
   const Vec2 d = predicted - s.centre;
@@ -438,7 +441,7 @@ void EkltTracker::optimise(Part& part, int index, std::size_t event_index) {
     part.timing.optimisation_s += start.seconds();
     return;
   }
-  addDerotatedStep(s, uv, t_mid);
+  addDerotatedStep(s, uv, rotated, t_mid);
   s.theta = sol.p[0];
   s.flow_angle = wrapAngle(sol.p[3]);
   s.quality = sol.quality();

@@ -115,16 +115,20 @@ class EkltTracker final : public FeatureTracker {
   void trackInParts(const EventArray& events, std::size_t begin, std::size_t end);
   void mergeChunkPoints();
   void optimise(Part& part, int slot_index, std::size_t event_index);
-  /// Where the feature of slot `s` is expected at time t: its last position
-  /// moved by the gyro's rotation since (imu_prediction) and, with
-  /// imu_prediction_translation_window_s, by its translational velocity
-  /// times the time since; or the last position itself (no prediction, or
-  /// one shorter than imu_prediction_min_shift_px).
-  Vec2 predictedCentre(const Slot& s, TimeNs t) const;
+  /// The last position of slot `s` moved by the gyro's rotation from then
+  /// to t (imu_prediction); nullopt without a prediction or when it cannot
+  /// be made.
+  std::optional<Vec2> rotatedCentre(const Slot& s, TimeNs t) const;
+  /// Where the feature of slot `s` is expected at time t: `rotated` and,
+  /// with imu_prediction_translation_window_s, its translational velocity
+  /// times the time since; or the last position itself (no rotation, or a
+  /// prediction shorter than imu_prediction_min_shift_px).
+  Vec2 predictedCentre(const Slot& s, const std::optional<Vec2>& rotated, TimeNs t) const;
   /// With imu_prediction_translation_window_s: the feature of slot `s`,
   /// still at its last position, is accepted at uv at time t; its derotated
-  /// path grows by the step less the gyro's rotation over it.
-  void addDerotatedStep(Slot& s, const Vec2& uv, TimeNs t) const;
+  /// path grows by the step less the gyro's rotation over it (`rotated`,
+  /// the last position when there is none).
+  void addDerotatedStep(Slot& s, const Vec2& uv, const std::optional<Vec2>& rotated, TimeNs t) const;
   /// The batch's solution from p0, re-solved from the reversed flow when
   /// implausible (EkltOptions::reversal_quality, max_batch_shift_px);
   /// nullopt when neither moves the feature plausibly (an invalid solution
